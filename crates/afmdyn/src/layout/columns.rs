@@ -43,6 +43,19 @@ pub enum Unit {
     Own(&'static str, &'static str),
 }
 
+impl UnitNames {
+    /// The names of a system of units (`si` whether SI): length, force, energy, frequency.
+    pub const fn new(si: bool, [length, force, energy, frequency]: [&'static str; 4]) -> Self {
+        UnitNames {
+            si,
+            length,
+            force,
+            energy,
+            frequency,
+        }
+    }
+}
+
 impl Unit {
     /// The unit's name among `names`.
     pub fn name(self, names: &UnitNames) -> &'static str {
@@ -87,6 +100,17 @@ pub struct Column<C, R> {
     /// How its value is taken from a row.
     pub get: Get<C, R>,
 }
+
+/// The columns of a result table, one per line — `name, unit, listed, long name, get;` (the
+/// fields of a [`Column`], `unit` a [`Unit`] and `get` a [`Get`] named without their enum) —
+/// as an array in that order.
+macro_rules! columns {
+    ($($name:literal, $unit:expr, $listed:expr, $long:expr, $get:expr;)*) => {{
+        use $crate::layout::columns::{Column, Get::*, Unit::*};
+        [$(Column { name: $name, unit: $unit, listed: $listed, long_name: $long, get: $get }),*]
+    }};
+}
+pub(crate) use columns;
 
 /// The values of `column` over `rows` as a JSON array (NaN as `null`).
 fn array<C, R>(column: &Column<C, R>, frame: &C, rows: &[R]) -> Value {
@@ -160,37 +184,13 @@ mod tests {
         n: usize,
     }
 
-    const NAMES: UnitNames = UnitNames {
-        si: true,
-        length: "m",
-        force: "N",
-        energy: "J",
-        frequency: "Hz",
-    };
+    const NAMES: UnitNames = UnitNames::new(true, ["m", "N", "J", "Hz"]);
 
-    const COLUMNS: [Column<f64, Point>; 3] = [
-        Column {
-            name: "x",
-            unit: Unit::Length,
-            listed: true,
-            long_name: "position",
-            get: Get::F64(|scale, p| p.x * scale),
-        },
-        Column {
-            name: "on",
-            unit: Unit::Fixed(""),
-            listed: false,
-            long_name: "flag",
-            get: Get::Bool(|p| p.on),
-        },
-        Column {
-            name: "n",
-            unit: Unit::Own("1 (SI)", "1"),
-            listed: true,
-            long_name: "count",
-            get: Get::Count(|p| p.n),
-        },
-    ];
+    const COLUMNS: [Column<f64, Point>; 3] = columns! {
+        "x", Length, true, "position", F64(|scale, p| p.x * scale);
+        "on", Fixed(""), false, "flag", Bool(|p| p.on);
+        "n", Own("1 (SI)", "1"), true, "count", Count(|p| p.n);
+    };
 
     fn points() -> [Point; 2] {
         let p = |x, on, n| Point { x, on, n };

@@ -14,7 +14,7 @@ use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference, FmSpec};
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::layout::columns::{self, Column, Get, Unit, UnitNames};
+use crate::layout::columns::{self, columns, Column, UnitNames};
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -313,176 +313,50 @@ impl Frame {
     /// The names of the document's units: SI with a probe (Hz for frequencies), else the
     /// model's (g₀, F̃ written `F`, Ω).
     fn names(&self) -> UnitNames {
-        if self.u.si {
-            UnitNames {
-                si: true,
-                length: "m",
-                force: "N",
-                energy: "J",
-                frequency: "Hz",
-            }
-        } else {
-            UnitNames {
-                si: false,
-                length: "g0",
-                force: "F",
-                energy: "F·g0",
-                frequency: "Ω",
-            }
+        match self.u.si {
+            true => UnitNames::new(true, ["m", "N", "J", "Hz"]),
+            false => UnitNames::new(false, ["g0", "F", "F·g0", "Ω"]),
         }
     }
 }
 
-/// An FM curve's column.
-type FmColumn = Column<Frame, FmPoint>;
-
-/// A number column of an FM curve.
-const fn number(
-    name: &'static str,
-    unit: Unit,
-    listed: bool,
-    long_name: &'static str,
-    get: fn(&Frame, &FmPoint) -> f64,
-) -> FmColumn {
-    Column {
-        name,
-        unit,
-        listed,
-        long_name,
-        get: Get::F64(get),
-    }
-}
-
 /// The columns of an FM curve, one entry per z_c reached: the document's `curve` arrays (and
-/// the units its `units` names), the layout's variables over `z_c` and the table `fm.csv`, in
-/// this order.
-const COLUMNS: [FmColumn; 18] = [
-    number("z_c", Unit::Length, true, "rest distance z_c", |f, q| {
-        f.z_c(q.alpha5)
-    }),
-    number(
-        "frequency_shift",
-        Unit::Own("Hz", "Ω (units of the τ scale)"),
-        true,
-        "frequency shift Δf = f − f_K",
-        |f, q| (q.omega - f.reference.omega) * f.hz,
-    ),
-    number(
-        "frequency",
-        Unit::Frequency,
-        true,
-        "drive frequency the PLL locks at",
-        |f, q| q.omega * f.hz,
-    ),
-    number(
-        "excitation",
-        Unit::Own(
-            "1 (relative to the free lever's at its resonance)",
-            "1 (relative)",
-        ),
-        true,
+/// the units its `units` names: those `true`), the layout's variables over `z_c` and the table
+/// `fm.csv`, in this order.
+const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
+    "z_c", Length, true, "rest distance z_c", F64(|f, q| f.z_c(q.alpha5));
+    "frequency_shift", Own("Hz", "Ω (units of the τ scale)"), true,
+        "frequency shift Δf = f − f_K", F64(|f, q| (q.omega - f.reference.omega) * f.hz);
+    "frequency", Frequency, true, "drive frequency the PLL locks at", F64(|f, q| q.omega * f.hz);
+    "excitation", Own("1 (relative to the free lever's at its resonance)", "1 (relative)"), true,
         "excitation relative to the free lever's at its resonance",
-        |f, q| q.alpha2 / f.reference.excitation,
-    ),
-    number(
-        "amplitude",
-        Unit::Length,
-        true,
-        "first-harmonic amplitude A1",
-        |f, q| q.observables.amplitude * f.u.length,
-    ),
-    number(
-        "phase_deg",
-        Unit::Fixed("deg"),
-        false,
-        "lag of the first harmonic behind the drive",
-        |_, q| q.observables.phase.to_degrees(),
-    ),
-    number(
-        "energy_dissipated",
-        Unit::Energy,
-        true,
-        "energy dissipated in the sample per cycle",
-        |f, q| q.observables.energy_dissipated * f.u.energy,
-    ),
-    number(
-        "virial",
-        Unit::Energy,
-        true,
-        "virial ⟨F_c W⟩",
-        |f, q| q.observables.virial * f.u.energy,
-    ),
-    number(
-        "mean_deflection",
-        Unit::Length,
-        false,
-        "mean deflection",
-        |f, q| q.observables.mean_deflection * f.u.length,
-    ),
-    number(
-        "min_distance",
-        Unit::Length,
-        true,
-        "tip–sample distance at the lower turning point",
-        |f, q| q.observables.min_distance * f.u.length,
-    ),
-    number(
-        "peak_force",
-        Unit::Force,
-        true,
-        "largest tip–sample force",
-        |f, q| q.observables.peak_force * f.u.force,
-    ),
-    number(
-        "mean_force",
-        Unit::Force,
-        false,
-        "mean tip–sample force",
-        |f, q| q.observables.mean_force * f.u.force,
-    ),
-    number(
-        "law_force",
-        Unit::Force,
-        false,
-        "the law's conservative force at the lower turning point",
-        |f, q| q.law_force * f.u.force,
-    ),
-    number(
-        "indentation",
-        Unit::Length,
-        false,
-        "largest indentation",
-        |f, q| q.observables.indentation * f.u.length,
-    ),
-    number(
-        "max_multiplier",
-        Unit::Fixed("1"),
-        false,
-        "largest Floquet multiplier modulus under the locked drive",
-        |_, q| q.multipliers.first().map_or(f64::NAN, |m| m.norm()),
-    ),
-    Column {
-        name: "stable",
-        unit: Unit::Fixed(""),
-        listed: false,
-        long_name: "Floquet-stable under the locked drive",
-        get: Get::Bool(|q| q.stable),
-    },
-    number(
-        "loop_residual",
-        Unit::Fixed("1"),
-        false,
-        "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
-        |_, q| q.loop_residual,
-    ),
-    Column {
-        name: "iterations",
-        unit: Unit::Fixed("1"),
-        listed: false,
-        long_name: "Newton iterations on (Ω, α2)",
-        get: Get::Count(|q| q.iterations),
-    },
-];
+        F64(|f, q| q.alpha2 / f.reference.excitation);
+    "amplitude", Length, true, "first-harmonic amplitude A1",
+        F64(|f, q| q.observables.amplitude * f.u.length);
+    "phase_deg", Fixed("deg"), false, "lag of the first harmonic behind the drive",
+        F64(|_, q| q.observables.phase.to_degrees());
+    "energy_dissipated", Energy, true, "energy dissipated in the sample per cycle",
+        F64(|f, q| q.observables.energy_dissipated * f.u.energy);
+    "virial", Energy, true, "virial ⟨F_c W⟩", F64(|f, q| q.observables.virial * f.u.energy);
+    "mean_deflection", Length, false, "mean deflection",
+        F64(|f, q| q.observables.mean_deflection * f.u.length);
+    "min_distance", Length, true, "tip–sample distance at the lower turning point",
+        F64(|f, q| q.observables.min_distance * f.u.length);
+    "peak_force", Force, true, "largest tip–sample force",
+        F64(|f, q| q.observables.peak_force * f.u.force);
+    "mean_force", Force, false, "mean tip–sample force",
+        F64(|f, q| q.observables.mean_force * f.u.force);
+    "law_force", Force, false, "the law's conservative force at the lower turning point",
+        F64(|f, q| q.law_force * f.u.force);
+    "indentation", Length, false, "largest indentation",
+        F64(|f, q| q.observables.indentation * f.u.length);
+    "max_multiplier", Fixed("1"), false, "largest Floquet multiplier modulus under the locked drive",
+        F64(|_, q| q.multipliers.first().map_or(f64::NAN, |m| m.norm()));
+    "stable", Fixed(""), false, "Floquet-stable under the locked drive", Bool(|q| q.stable);
+    "loop_residual", Fixed("1"), false, "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
+        F64(|_, q| q.loop_residual);
+    "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|q| q.iterations);
+};
 
 /// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
 /// per quantity of [`COLUMNS`], one entry per z_c reached), `folds`, `reference` (the free
