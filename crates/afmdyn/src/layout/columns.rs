@@ -54,6 +54,15 @@ impl UnitNames {
             frequency,
         }
     }
+
+    /// SI's names (m, N, J, Hz) when `si`, else the model's as the FM and PeakForce documents
+    /// write them (g0, F, F·g0, Ω).
+    pub const fn si_or_model(si: bool) -> Self {
+        match si {
+            true => UnitNames::new(true, ["m", "N", "J", "Hz"]),
+            false => UnitNames::new(false, ["g0", "F", "F·g0", "Ω"]),
+        }
+    }
 }
 
 impl Unit {
@@ -85,6 +94,8 @@ pub enum Get<C, R> {
     Bool(fn(&R) -> bool),
     /// A count (a layout's 32-bit integer).
     Count(fn(&R) -> usize),
+    /// A number that may be missing (`null` in the document, NaN in the layout and the table).
+    Opt(fn(&C, &R) -> Option<f64>),
 }
 
 /// One column of a result table.
@@ -118,6 +129,7 @@ fn array<C, R>(column: &Column<C, R>, frame: &C, rows: &[R]) -> Value {
         Get::F64(f) => rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>().into(),
         Get::Bool(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
         Get::Count(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
+        Get::Opt(f) => serde_json::json!(rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>()),
     }
 }
 
@@ -150,6 +162,11 @@ pub fn variables<C, R>(
         Get::F64(f) => Values::F64(rows.iter().map(|r| f(frame, r)).collect()),
         Get::Bool(f) => Values::Bool(rows.iter().map(f).collect()),
         Get::Count(f) => Values::I32(rows.iter().map(|r| f(r) as i32).collect()),
+        Get::Opt(f) => Values::F64(
+            rows.iter()
+                .map(|r| f(frame, r).unwrap_or(f64::NAN))
+                .collect(),
+        ),
     };
     let variable = |c: &Column<C, R>| {
         let unit = c.unit.name(names);
@@ -169,6 +186,7 @@ pub fn rows<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Vec<Vec<f6
         Get::F64(f) => f(frame, r),
         Get::Bool(f) => f64::from(u8::from(f(r))),
         Get::Count(f) => f(r) as f64,
+        Get::Opt(f) => f(frame, r).unwrap_or(f64::NAN),
     };
     let row = |r: &R| columns.iter().map(|c| cell(c, r)).collect();
     rows.iter().map(row).collect()
@@ -186,10 +204,11 @@ mod tests {
 
     const NAMES: UnitNames = UnitNames::new(true, ["m", "N", "J", "Hz"]);
 
-    const COLUMNS: [Column<f64, Point>; 3] = columns! {
+    const COLUMNS: [Column<f64, Point>; 4] = columns! {
         "x", Length, true, "position", F64(|scale, p| p.x * scale);
         "on", Fixed(""), false, "flag", Bool(|p| p.on);
         "n", Own("1 (SI)", "1"), true, "count", Count(|p| p.n);
+        "y", Force, false, "force", Opt(|_, p| p.on.then_some(p.x));
     };
 
     fn points() -> [Point; 2] {
@@ -201,7 +220,8 @@ mod tests {
     fn one_declaration_gives_every_form_of_the_table() {
         let p = points();
         let doc = Value::Object(arrays(&COLUMNS, &2.0, &p));
-        let expected = serde_json::json!({"x": [2.0, null], "on": [true, false], "n": [3, 4]});
+        let expected = serde_json::json!({"x": [2.0, null], "on": [true, false], "n": [3, 4],
+                                          "y": [1.0, null]});
         assert_eq!(doc, expected);
         let u = Value::Object(units(&COLUMNS, &NAMES));
         assert_eq!(u, serde_json::json!({"x": "m", "n": "1 (SI)"}));
@@ -212,12 +232,13 @@ mod tests {
             .iter()
             .map(|v| (v.name.as_str(), v.units.as_str()))
             .collect();
-        assert_eq!(described, [("x", "m"), ("on", ""), ("n", "1")]);
+        assert_eq!(described, [("x", "m"), ("on", ""), ("n", "1"), ("y", "N")]);
         assert_eq!(vars[1].values, Values::Bool(vec![true, false]));
         assert_eq!(vars[2].values, Values::I32(vec![3, 4]));
-        assert_eq!(names(&COLUMNS), ["x", "on", "n"]);
+        assert!(matches!(&vars[3].values, Values::F64(y) if y[0] == 1.0 && y[1].is_nan()));
+        assert_eq!(names(&COLUMNS), ["x", "on", "n", "y"]);
         let table = rows(&COLUMNS, &2.0, &p);
-        assert_eq!(table[0], [2.0, 1.0, 3.0]);
-        assert!(table[1][0].is_nan() && table[1][1..] == [0.0, 4.0]);
+        assert_eq!(table[0], [2.0, 1.0, 3.0, 1.0]);
+        assert!(table[1][0].is_nan() && table[1][1..3] == [0.0, 4.0] && table[1][3].is_nan());
     }
 }

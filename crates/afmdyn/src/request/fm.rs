@@ -309,15 +309,6 @@ impl Frame {
             .rest_distance()
             * self.u.length
     }
-
-    /// The names of the document's units: SI with a probe (Hz for frequencies), else the
-    /// model's (g₀, F̃ written `F`, Ω).
-    fn names(&self) -> UnitNames {
-        match self.u.si {
-            true => UnitNames::new(true, ["m", "N", "J", "Hz"]),
-            false => UnitNames::new(false, ["g0", "F", "F·g0", "Ω"]),
-        }
-    }
 }
 
 /// The columns of an FM curve, one entry per z_c reached: the document's `curve` arrays (and
@@ -368,7 +359,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
     let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
     let spring_constant = r.stiffness * u.force / u.length;
-    let mut units = columns::units(&COLUMNS, &frame.names());
+    let mut units = columns::units(&COLUMNS, &UnitNames::si_or_model(frame.u.si));
     if u.si {
         units.insert("spring_constant".into(), "N/m".into());
     }
@@ -438,7 +429,13 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
 pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
     let frame = Frame::new(model, curve);
     let p = &curve.points;
-    let variables = columns::variables(&COLUMNS, &frame, p, &["z_c"], &frame.names());
+    let variables = columns::variables(
+        &COLUMNS,
+        &frame,
+        p,
+        &["z_c"],
+        &UnitNames::si_or_model(frame.u.si),
+    );
     crate::layout::Layout::new("fm", &[("z_c", p.len())], variables)
 }
 
