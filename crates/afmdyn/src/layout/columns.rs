@@ -91,9 +91,9 @@ pub enum Get<C, R> {
     /// A number.
     F64(fn(&C, &R) -> f64),
     /// A flag (a table's 1/0).
-    Bool(fn(&R) -> bool),
+    Bool(fn(&C, &R) -> bool),
     /// A count (a layout's 32-bit integer).
-    Count(fn(&R) -> usize),
+    Count(fn(&C, &R) -> usize),
     /// A number that may be missing (`null` in the document, NaN in the layout and the table).
     Opt(fn(&C, &R) -> Option<f64>),
 }
@@ -127,8 +127,8 @@ pub(crate) use columns;
 fn array<C, R>(column: &Column<C, R>, frame: &C, rows: &[R]) -> Value {
     match column.get {
         Get::F64(f) => rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>().into(),
-        Get::Bool(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
-        Get::Count(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
+        Get::Bool(f) => rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>().into(),
+        Get::Count(f) => rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>().into(),
         Get::Opt(f) => serde_json::json!(rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>()),
     }
 }
@@ -160,8 +160,8 @@ pub fn variables<C, R>(
 ) -> Vec<Variable> {
     let values = |get: &Get<C, R>| match *get {
         Get::F64(f) => Values::F64(rows.iter().map(|r| f(frame, r)).collect()),
-        Get::Bool(f) => Values::Bool(rows.iter().map(f).collect()),
-        Get::Count(f) => Values::I32(rows.iter().map(|r| f(r) as i32).collect()),
+        Get::Bool(f) => Values::Bool(rows.iter().map(|r| f(frame, r)).collect()),
+        Get::Count(f) => Values::I32(rows.iter().map(|r| f(frame, r) as i32).collect()),
         Get::Opt(f) => Values::F64(
             rows.iter()
                 .map(|r| f(frame, r).unwrap_or(f64::NAN))
@@ -180,15 +180,47 @@ pub fn names<C, R>(columns: &[Column<C, R>]) -> Vec<&'static str> {
     columns.iter().map(|c| c.name).collect()
 }
 
+/// The document's maps over a grid of `shape` (lines, pixels): one per column, keyed by its
+/// name, as nested arrays `[line][pixel]` of the `rows` (the grid's cells, line by line).
+pub fn grids<C, R>(
+    columns: &[Column<C, R>],
+    frame: &C,
+    rows: &[R],
+    (lines, pixels): (usize, usize),
+) -> Map<String, Value> {
+    let grid = |c: &Column<C, R>| {
+        let Value::Array(flat) = array(c, frame, rows) else {
+            unreachable!("a column's values are an array")
+        };
+        let line = |j: usize| Value::Array(flat[j * pixels..(j + 1) * pixels].to_vec());
+        (c.name.into(), Value::Array((0..lines).map(line).collect()))
+    };
+    columns.iter().map(grid).collect()
+}
+
+/// The cells (line, pixel) of a grid of `shape` (lines, pixels), line by line: the rows of
+/// its maps ([`grids`], and a layout's variables over (y, x)).
+pub fn cells((lines, pixels): (usize, usize)) -> Vec<(usize, usize)> {
+    (0..lines)
+        .flat_map(|j| (0..pixels).map(move |i| (j, i)))
+        .collect()
+}
+
+impl<C, R> Column<C, R> {
+    /// Its value at `row` as a number (flags as 1/0, NaN where missing).
+    pub fn number(&self, frame: &C, row: &R) -> f64 {
+        match self.get {
+            Get::F64(f) => f(frame, row),
+            Get::Bool(f) => f64::from(u8::from(f(frame, row))),
+            Get::Count(f) => f(frame, row) as f64,
+            Get::Opt(f) => f(frame, row).unwrap_or(f64::NAN),
+        }
+    }
+}
+
 /// The table's rows, one per row, in the columns' order (flags as 1/0).
 pub fn rows<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Vec<Vec<f64>> {
-    let cell = |c: &Column<C, R>, r: &R| match c.get {
-        Get::F64(f) => f(frame, r),
-        Get::Bool(f) => f64::from(u8::from(f(r))),
-        Get::Count(f) => f(r) as f64,
-        Get::Opt(f) => f(frame, r).unwrap_or(f64::NAN),
-    };
-    let row = |r: &R| columns.iter().map(|c| cell(c, r)).collect();
+    let row = |r: &R| columns.iter().map(|c| c.number(frame, r)).collect();
     rows.iter().map(row).collect()
 }
 
@@ -206,8 +238,8 @@ mod tests {
 
     const COLUMNS: [Column<f64, Point>; 4] = columns! {
         "x", Length, true, "position", F64(|scale, p| p.x * scale);
-        "on", Fixed(""), false, "flag", Bool(|p| p.on);
-        "n", Own("1 (SI)", "1"), true, "count", Count(|p| p.n);
+        "on", Fixed(""), false, "flag", Bool(|_, p| p.on);
+        "n", Own("1 (SI)", "1"), true, "count", Count(|_, p| p.n);
         "y", Force, false, "force", Opt(|_, p| p.on.then_some(p.x));
     };
 
@@ -240,5 +272,10 @@ mod tests {
         let table = rows(&COLUMNS, &2.0, &p);
         assert_eq!(table[0], [2.0, 1.0, 3.0, 1.0]);
         assert!(table[1][0].is_nan() && table[1][1..3] == [0.0, 4.0] && table[1][3].is_nan());
+        let grid = Value::Object(grids(&COLUMNS[..2], &2.0, &p, (2, 1)));
+        assert_eq!(
+            grid,
+            serde_json::json!({"x": [[2.0], [null]], "on": [[true], [false]]})
+        );
     }
 }

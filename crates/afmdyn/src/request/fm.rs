@@ -343,10 +343,10 @@ const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
         F64(|f, q| q.observables.indentation * f.u.length);
     "max_multiplier", Fixed("1"), false, "largest Floquet multiplier modulus under the locked drive",
         F64(|_, q| q.multipliers.first().map_or(f64::NAN, |m| m.norm()));
-    "stable", Fixed(""), false, "Floquet-stable under the locked drive", Bool(|q| q.stable);
+    "stable", Fixed(""), false, "Floquet-stable under the locked drive", Bool(|_, q| q.stable);
     "loop_residual", Fixed("1"), false, "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
         F64(|_, q| q.loop_residual);
-    "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|q| q.iterations);
+    "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|_, q| q.iterations);
 };
 
 /// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
