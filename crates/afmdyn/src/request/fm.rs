@@ -350,7 +350,7 @@ const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
 };
 
 /// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
-/// per quantity of [`COLUMNS`], one entry per z_c reached), `folds`, `reference` (the free
+/// per quantity of `COLUMNS`, one entry per z_c reached), `folds`, `reference` (the free
 /// lever's operating point), the cantilever's constants that [`super::reconstruct`] needs
 /// (`spring_constant`, `resonance_frequency`, `amplitude`), `units` (those of the columns it
 /// lists, and with a probe the spring constant's), `method`, `warnings`.
@@ -423,7 +423,7 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
 }
 
 /// The layout of an FM curve: over `z_c` (the rest distance, its coordinate) every column of
-/// [`COLUMNS`], in the document's units (SI with a probe, the model's without; `deg` for the
+/// `COLUMNS`, in the document's units (SI with a probe, the model's without; `deg` for the
 /// phase, `1` for the pure numbers); `stable` flags, `iterations` integers. What Python's
 /// `afmdyn.fm` returns.
 pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
@@ -439,7 +439,7 @@ pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
     crate::layout::Layout::new("fm", &[("z_c", p.len())], variables)
 }
 
-/// The table of an FM curve (`fm.csv`): the names of [`COLUMNS`] and one row per z_c reached
+/// The table of an FM curve (`fm.csv`): the names of `COLUMNS` and one row per z_c reached
 /// (`stable` as 1/0).
 pub fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
     let frame = Frame::new(model, curve);

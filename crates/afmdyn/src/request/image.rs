@@ -698,7 +698,7 @@ impl Image {
     }
 
     /// The image document (`afmdyn image --json`): `image` with `x`, `y` (m) and per
-    /// `[line][pixel]` the [`FIELDS`] (null where not reached), `regime`, `material` and
+    /// `[line][pixel]` the `FIELDS` (null where not reached), `regime`, `material` and
     /// `domain` (their names); `materials` with their operating points; `reference_z_c` (m),
     /// `setpoint`, `warnings`.
     pub fn document(&self, setpoint: f64) -> Value {

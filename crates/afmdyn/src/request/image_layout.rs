@@ -79,7 +79,7 @@ fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
 }
 
 /// The image's layout: coordinates `x`, `y` (m: pixel centres and line positions); over
-/// (y, x) the [`FIELDS`](super::image::FIELDS) as 64-bit floats in SI (NaN where the setpoint is not reached),
+/// (y, x) the `FIELDS` as 64-bit floats in SI (NaN where the setpoint is not reached),
 /// `regime` (codes [`REGIME_FLAGS`]), `material` (index into the image's materials, 0 the
 /// background) and `domain` (0 the background, k the map's k-th domain), each 32-bit integer
 /// codes with their CF `flag_values` and `flag_meanings`; the scalars `setpoint` (A_sp/A₀, as
@@ -127,7 +127,7 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
     )
 }
 
-/// The PI scan's layout: coordinates `x`, `y` (m); over (y, x) the [`SCAN_FIELDS`] of the
+/// The PI scan's layout: coordinates `x`, `y` (m); over (y, x) the `SCAN_FIELDS` of the
 /// trace and, suffixed `_retrace`, of the retrace (64-bit floats in SI), `lost_contact` and
 /// `lost_contact_retrace` (flags), `regime` and `material` of each direction (codes as in
 /// [`layout`]), `ideal_height` (m, the ideal image's apparent height), `true_height` (m) and

@@ -652,7 +652,7 @@ impl PeakForceImage {
         self.pixels[line][pixel].tap.as_ref()
     }
 
-    /// The value of the map `name` ([`PF_FIELDS`]) at (line, pixel) (NaN where not reached or
+    /// The value of the map `name` (`PF_FIELDS`) at (line, pixel) (NaN where not reached or
     /// an unknown name).
     pub fn value(&self, name: &str, line: usize, pixel: usize) -> f64 {
         let field = PF_FIELDS.iter().find(|c| c.name == name);
@@ -660,7 +660,7 @@ impl PeakForceImage {
     }
 
     /// The image document (`afmdyn image --mode peakforce --json`): `image` with `x`, `y` (m)
-    /// and per `[line][pixel]` the [`PF_FIELDS`] (SI; null where not reached), `evaluations`,
+    /// and per `[line][pixel]` the `PF_FIELDS` (SI; null where not reached), `evaluations`,
     /// `material` and `domain` (names); `mode` `"peakforce"`, `feedback` `"ideal"`, `setpoint`
     /// (N), `reference_z_c` (m), `materials` (each with its true modulus and engaged operating
     /// point), `taps` (steady taps computed), `warnings`.

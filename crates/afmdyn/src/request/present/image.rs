@@ -378,7 +378,7 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
 /// ([`crate::request::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
 /// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point,
 /// as [`PeakForceImage::document_head`], and its pixels: `pixels`, `taps` the steady taps of
-/// the continuations into them, `reengaged`, and `maps`, each of [`PF_FIELDS`] summarised
+/// the continuations into them, `reengaged`, and `maps`, each of `PF_FIELDS` summarised
 /// over them as [`number_summary`]), `taps`, `warnings`. [`PeakForceImage::document`] is the
 /// document with every pixel.
 pub fn peakforce_summary(img: &PeakForceImage) -> Value {
