@@ -13,7 +13,7 @@ use serde_json::{Map, Value};
 /// The names of the units of a result's kinds of quantity in one system of units (SI with a
 /// probe, the model's without).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct UnitNames {
+pub(crate) struct UnitNames {
     /// Whether these are SI names ([`Unit::Own`] takes its first name then).
     pub si: bool,
     /// Lengths.
@@ -28,7 +28,7 @@ pub struct UnitNames {
 
 /// Where a column's unit comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Unit {
+pub(crate) enum Unit {
     /// The result's length unit.
     Length,
     /// The result's force unit.
@@ -45,7 +45,10 @@ pub enum Unit {
 
 impl UnitNames {
     /// The names of a system of units (`si` whether SI): length, force, energy, frequency.
-    pub const fn new(si: bool, [length, force, energy, frequency]: [&'static str; 4]) -> Self {
+    pub(crate) const fn new(
+        si: bool,
+        [length, force, energy, frequency]: [&'static str; 4],
+    ) -> Self {
         UnitNames {
             si,
             length,
@@ -57,7 +60,7 @@ impl UnitNames {
 
     /// SI's names (m, N, J, Hz) when `si`, else the model's as the FM and PeakForce documents
     /// write them (g0, F, F·g0, Ω).
-    pub const fn si_or_model(si: bool) -> Self {
+    pub(crate) const fn si_or_model(si: bool) -> Self {
         match si {
             true => UnitNames::new(true, ["m", "N", "J", "Hz"]),
             false => UnitNames::new(false, ["g0", "F", "F·g0", "Ω"]),
@@ -67,7 +70,7 @@ impl UnitNames {
 
 impl Unit {
     /// The unit's name among `names`.
-    pub fn name(self, names: &UnitNames) -> &'static str {
+    pub(crate) fn name(self, names: &UnitNames) -> &'static str {
         match self {
             Unit::Length => names.length,
             Unit::Force => names.force,
@@ -87,7 +90,7 @@ impl Unit {
 
 /// How a column's value is taken from a row `R` read through a frame `C`; the variant is the
 /// kind of the values.
-pub enum Get<C, R> {
+pub(crate) enum Get<C, R> {
     /// A number.
     F64(fn(&C, &R) -> f64),
     /// A flag (a table's 1/0).
@@ -99,7 +102,7 @@ pub enum Get<C, R> {
 }
 
 /// One column of a result table.
-pub struct Column<C, R> {
+pub(crate) struct Column<C, R> {
     /// Its name: the document's key, the variable's and the table column's.
     pub name: &'static str,
     /// Where its unit comes from.
@@ -134,7 +137,7 @@ fn array<C, R>(column: &Column<C, R>, frame: &C, rows: &[R]) -> Value {
 }
 
 /// The document's arrays: one per column, keyed by its name, one entry per row.
-pub fn arrays<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Map<String, Value> {
+pub(crate) fn arrays<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Map<String, Value> {
     let named = columns
         .iter()
         .map(|c| (c.name.into(), array(c, frame, rows)));
@@ -142,7 +145,7 @@ pub fn arrays<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Map<Stri
 }
 
 /// The document's `units` object: the unit of each column it names ([`Column::listed`]).
-pub fn units<C, R>(columns: &[Column<C, R>], names: &UnitNames) -> Map<String, Value> {
+pub(crate) fn units<C, R>(columns: &[Column<C, R>], names: &UnitNames) -> Map<String, Value> {
     let listed = columns.iter().filter(|c| c.listed);
     listed
         .map(|c| (c.name.into(), c.unit.name(names).into()))
@@ -151,7 +154,7 @@ pub fn units<C, R>(columns: &[Column<C, R>], names: &UnitNames) -> Map<String, V
 
 /// The layout's variables: one per column over `dims`, in the columns' order, with its unit
 /// and long name.
-pub fn variables<C, R>(
+pub(crate) fn variables<C, R>(
     columns: &[Column<C, R>],
     frame: &C,
     rows: &[R],
@@ -176,13 +179,13 @@ pub fn variables<C, R>(
 }
 
 /// The table's column names, in order.
-pub fn names<C, R>(columns: &[Column<C, R>]) -> Vec<&'static str> {
+pub(crate) fn names<C, R>(columns: &[Column<C, R>]) -> Vec<&'static str> {
     columns.iter().map(|c| c.name).collect()
 }
 
 /// The document's maps over a grid of `shape` (lines, pixels): one per column, keyed by its
 /// name, as nested arrays `[line][pixel]` of the `rows` (the grid's cells, line by line).
-pub fn grids<C, R>(
+pub(crate) fn grids<C, R>(
     columns: &[Column<C, R>],
     frame: &C,
     rows: &[R],
@@ -200,7 +203,7 @@ pub fn grids<C, R>(
 
 /// The cells (line, pixel) of a grid of `shape` (lines, pixels), line by line: the rows of
 /// its maps ([`grids`], and a layout's variables over (y, x)).
-pub fn cells((lines, pixels): (usize, usize)) -> Vec<(usize, usize)> {
+pub(crate) fn cells((lines, pixels): (usize, usize)) -> Vec<(usize, usize)> {
     (0..lines)
         .flat_map(|j| (0..pixels).map(move |i| (j, i)))
         .collect()
@@ -208,7 +211,7 @@ pub fn cells((lines, pixels): (usize, usize)) -> Vec<(usize, usize)> {
 
 impl<C, R> Column<C, R> {
     /// Its value at `row` as a number (flags as 1/0, NaN where missing).
-    pub fn number(&self, frame: &C, row: &R) -> f64 {
+    pub(crate) fn number(&self, frame: &C, row: &R) -> f64 {
         match self.get {
             Get::F64(f) => f(frame, row),
             Get::Bool(f) => f64::from(u8::from(f(frame, row))),
@@ -219,7 +222,7 @@ impl<C, R> Column<C, R> {
 }
 
 /// The table's rows, one per row, in the columns' order (flags as 1/0).
-pub fn rows<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Vec<Vec<f64>> {
+pub(crate) fn rows<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Vec<Vec<f64>> {
     let row = |r: &R| columns.iter().map(|c| c.number(frame, r)).collect();
     rows.iter().map(row).collect()
 }
