@@ -10,7 +10,6 @@ use afmdyn::layout::{Layout, Values};
 use afmdyn::probe::Probe;
 use afmdyn::request::image::setpoint_study;
 use afmdyn::request::image_job::ImageKeywords;
-use afmdyn::request::present::fm::COLUMNS;
 use afmdyn::request::{named, Outcome, Resolved};
 use afmdyn::Params;
 use serde_json::{json, Value};
@@ -61,6 +60,28 @@ fn as_json(v: &Values) -> Vec<Value> {
     }
 }
 
+/// The columns of the table `fm.csv`, in its order.
+const FM_COLUMNS: [&str; 18] = [
+    "z_c",
+    "frequency_shift",
+    "frequency",
+    "excitation",
+    "amplitude",
+    "phase_deg",
+    "energy_dissipated",
+    "virial",
+    "mean_deflection",
+    "min_distance",
+    "peak_force",
+    "mean_force",
+    "law_force",
+    "indentation",
+    "max_multiplier",
+    "stable",
+    "loop_residual",
+    "iterations",
+];
+
 #[test]
 fn the_fm_layout_is_the_documents_curve_in_its_units() {
     for with_probe in [false, true] {
@@ -70,7 +91,7 @@ fn the_fm_layout_is_the_documents_curve_in_its_units() {
         let units = &doc["units"];
         // the variables of the table fm.csv, in its order, each over z_c
         let names: Vec<&str> = layout.variables.iter().map(|v| v.name.as_str()).collect();
-        assert_eq!(names, COLUMNS);
+        assert_eq!(names, FM_COLUMNS);
         assert_eq!(layout.dim("z_c"), Some(4));
         for v in &layout.variables {
             assert_eq!(v.dims, ["z_c"], "{}", v.name);

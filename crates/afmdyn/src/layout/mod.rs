@@ -8,6 +8,7 @@
 //! Values are row-major over the variable's dimensions (the last one fastest), as NetCDF,
 //! NumPy and xarray store them.
 
+pub(crate) mod columns;
 pub mod figure;
 #[cfg(feature = "files")]
 pub mod files;

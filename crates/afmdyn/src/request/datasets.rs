@@ -1,7 +1,7 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
-//! The stepped curves' layouts are laid out from their documents, and so is `fm`'s
-//! ([`super::fm::layout`]); `reconstruct`'s is [`super::reconstruct::layout`].
+//! The stepped curves' layouts are laid out from their documents; `fm`'s is
+//! [`super::fm::layout`], `reconstruct`'s [`super::reconstruct::layout`].
 
 use super::modes::ModesRequest;
 use super::named::Datasets;
@@ -334,10 +334,9 @@ impl Datasets for ResonanceRequest {
 }
 
 impl Datasets for FmRequest {
-    /// The curve's layout `fm` from its document ([`super::fm::layout`]).
+    /// The curve's layout `fm` ([`super::fm::layout`]).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        let doc = super::fm::document(self, model, curve);
-        one("fm", super::fm::layout(&doc))
+        one("fm", super::fm::layout(model, curve))
     }
 }
 

@@ -9,10 +9,12 @@ use super::curves::CurveRequest;
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::approach::approach_spec;
-use crate::analysis::fm::{fm_curve, FmCurve, FmSpec, DEFAULT_LOOP_TOLERANCE};
+use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
+use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference, FmSpec};
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::layout::columns::{self, columns, Column, UnitNames};
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -265,14 +267,15 @@ impl Analysis for FmRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
-        _: &FmCurve,
+        model: &Resolved,
+        curve: &FmCurve,
         document: &Value,
         units: crate::report::TextUnits,
         to: super::run::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        let mut shown = super::present::fm::fm(&mut document, units, to.files, to.dir);
+        let table = table(model, curve);
+        let mut shown = super::present::fm::fm(&mut document, table, units, to.files, to.dir);
         shown.document = Some(document);
         Ok(shown)
     }
@@ -282,28 +285,110 @@ impl Analysis for FmRequest {
     }
 }
 
-/// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
-/// per quantity, one entry per z_c reached), `folds`, `reference` (the free lever's operating
-/// point), the cantilever's constants that [`super::reconstruct`] needs (`spring_constant`,
-/// `resonance_frequency`, `amplitude`), `units`, `method`, `warnings`.
-pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
-    let u = FmRequest::units(model);
-    let hz = u.hz_per_omega.unwrap_or(1.0);
-    let p = &curve.points;
-    let col = |f: &dyn Fn(&crate::analysis::fm::FmPoint) -> f64| -> Vec<f64> {
-        p.iter().map(f).collect()
-    };
-    let base = model.params;
-    let z_c = |a5: f64| {
-        base.with(crate::params::SweepParam::Alpha5, a5)
+/// What an FM point's columns ([`COLUMNS`]) are read through: the document's units, Hz per
+/// unit Ω (1 without a probe), the free lever's operating point and the model (z_c from α5).
+struct Frame {
+    u: CurveUnits,
+    hz: f64,
+    reference: FmReference,
+    base: crate::Params,
+}
+
+impl Frame {
+    fn new(model: &Resolved, curve: &FmCurve) -> Frame {
+        let u = FmRequest::units(model);
+        Frame {
+            u,
+            hz: u.hz_per_omega.unwrap_or(1.0),
+            reference: curve.reference,
+            base: model.params,
+        }
+    }
+
+    /// The rest distance at α5 = `a5` in the document's length unit.
+    fn z_c(&self, a5: f64) -> f64 {
+        self.base
+            .with(crate::params::SweepParam::Alpha5, a5)
             .rest_distance()
-    };
-    let u_len = u.length;
-    let r = &curve.reference;
-    let max_mult =
-        |q: &crate::analysis::fm::FmPoint| q.multipliers.first().map_or(f64::NAN, |m| m.norm());
+            * self.u.length
+    }
+}
+
+/// The columns of an FM curve, one entry per z_c reached: the document's `curve` arrays (and
+/// the units its `units` names: those `true`), the layout's variables over `z_c` and the table
+/// `fm.csv`, in this order.
+const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
+    "z_c", Length, true, "rest distance z_c", F64(|f, q| f.z_c(q.alpha5));
+    "frequency_shift", Own("Hz", "Ω (units of the τ scale)"), true,
+        "frequency shift Δf = f − f_K", F64(|f, q| (q.omega - f.reference.omega) * f.hz);
+    "frequency", Frequency, true, "drive frequency the PLL locks at", F64(|f, q| q.omega * f.hz);
+    "excitation", Own("1 (relative to the free lever's at its resonance)", "1 (relative)"), true,
+        "excitation relative to the free lever's at its resonance",
+        F64(|f, q| q.alpha2 / f.reference.excitation);
+    "amplitude", Length, true, "first-harmonic amplitude A1",
+        F64(|f, q| q.observables.amplitude * f.u.length);
+    "phase_deg", Fixed("deg"), false, "lag of the first harmonic behind the drive",
+        F64(|_, q| q.observables.phase.to_degrees());
+    "energy_dissipated", Energy, true, "energy dissipated in the sample per cycle",
+        F64(|f, q| q.observables.energy_dissipated * f.u.energy);
+    "virial", Energy, true, "virial ⟨F_c W⟩", F64(|f, q| q.observables.virial * f.u.energy);
+    "mean_deflection", Length, false, "mean deflection",
+        F64(|f, q| q.observables.mean_deflection * f.u.length);
+    "min_distance", Length, true, "tip–sample distance at the lower turning point",
+        F64(|f, q| q.observables.min_distance * f.u.length);
+    "peak_force", Force, true, "largest tip–sample force",
+        F64(|f, q| q.observables.peak_force * f.u.force);
+    "mean_force", Force, false, "mean tip–sample force",
+        F64(|f, q| q.observables.mean_force * f.u.force);
+    "law_force", Force, false, "the law's conservative force at the lower turning point",
+        F64(|f, q| q.law_force * f.u.force);
+    "indentation", Length, false, "largest indentation",
+        F64(|f, q| q.observables.indentation * f.u.length);
+    "max_multiplier", Fixed("1"), false, "largest Floquet multiplier modulus under the locked drive",
+        F64(|_, q| q.multipliers.first().map_or(f64::NAN, |m| m.norm()));
+    "stable", Fixed(""), false, "Floquet-stable under the locked drive", Bool(|_, q| q.stable);
+    "loop_residual", Fixed("1"), false, "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
+        F64(|_, q| q.loop_residual);
+    "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|_, q| q.iterations);
+};
+
+/// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
+/// per quantity of `COLUMNS`, one entry per z_c reached), `folds`, `reference` (the free
+/// lever's operating point), the cantilever's constants that [`super::reconstruct`] needs
+/// (`spring_constant`, `resonance_frequency`, `amplitude`), `units` (those of the columns it
+/// lists, and with a probe the spring constant's), `method`, `warnings`.
+pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
+    let frame = Frame::new(model, curve);
+    let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
     let spring_constant = r.stiffness * u.force / u.length;
+    let mut units = columns::units(&COLUMNS, &UnitNames::si_or_model(frame.u.si));
+    if u.si {
+        units.insert("spring_constant".into(), "N/m".into());
+    }
+    json!({
+        "curve": columns::arrays(&COLUMNS, &frame, &curve.points),
+        "folds": curve.folds.iter().map(|f| json!({"index": f.index, "z_c": frame.z_c(f.alpha5)})).collect::<Vec<_>>(),
+        "reference": {
+            "resonance_frequency": r.omega * hz,
+            "quality_factor": r.quality_factor,
+            "phase_deg": r.phase.to_degrees(),
+            "excitation": r.excitation,
+            "stiffness": spring_constant,
+        },
+        "mode": request.mode,
+        "amplitude": curve.amplitude * u.length,
+        "spring_constant": spring_constant,
+        "resonance_frequency": r.omega * hz,
+        "units": units,
+        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/afm-workflow.md)",
+        "warnings": warnings(request, model, &frame, curve),
+    })
+}
+
+/// The warnings of an FM curve's document: an amplitude outside the probe's typical range, ends
+/// given the wrong way round, a steady state not found.
+fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurve) -> Vec<String> {
     let mut warnings: Vec<String> = Vec::new();
     let unit = if model.probe.is_some() { "m" } else { "g0" };
     if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
@@ -332,182 +417,35 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
         warnings.push(format!(
             "the FM steady state was not found at z_c = {}{} and beyond ({}); the curve ends at \
              the previous value",
-            crate::error::number(z_c(u.alpha5) * u_len),
+            crate::error::number(frame.z_c(u.alpha5)),
             if model.probe.is_some() { " m" } else { " g0" },
             u.reason
         ));
     }
-    json!({
-        "curve": {
-            "z_c": col(&|q| z_c(q.alpha5) * u.length),
-            "frequency_shift": col(&|q| (q.omega - r.omega) * hz),
-            "frequency": col(&|q| q.omega * hz),
-            "excitation": col(&|q| q.alpha2 / r.excitation),
-            "amplitude": col(&|q| q.observables.amplitude * u.length),
-            "phase_deg": col(&|q| q.observables.phase.to_degrees()),
-            "energy_dissipated": col(&|q| q.observables.energy_dissipated * u.energy),
-            "virial": col(&|q| q.observables.virial * u.energy),
-            "mean_deflection": col(&|q| q.observables.mean_deflection * u.length),
-            "min_distance": col(&|q| q.observables.min_distance * u.length),
-            "peak_force": col(&|q| q.observables.peak_force * u.force),
-            "mean_force": col(&|q| q.observables.mean_force * u.force),
-            "law_force": col(&|q| q.law_force * u.force),
-            "indentation": col(&|q| q.observables.indentation * u.length),
-            "max_multiplier": col(&max_mult),
-            "stable": p.iter().map(|q| q.stable).collect::<Vec<bool>>(),
-            "loop_residual": col(&|q| q.loop_residual),
-            "iterations": p.iter().map(|q| q.iterations).collect::<Vec<usize>>(),
-        },
-        "folds": curve.folds.iter().map(|f| json!({"index": f.index, "z_c": z_c(f.alpha5) * u.length})).collect::<Vec<_>>(),
-        "reference": {
-            "resonance_frequency": r.omega * hz,
-            "quality_factor": r.quality_factor,
-            "phase_deg": r.phase.to_degrees(),
-            "excitation": r.excitation,
-            "stiffness": spring_constant,
-        },
-        "mode": request.mode,
-        "amplitude": curve.amplitude * u.length,
-        "spring_constant": spring_constant,
-        "resonance_frequency": r.omega * hz,
-        "units": if u.si {
-            json!({"z_c": "m", "frequency_shift": "Hz", "frequency": "Hz", "excitation": "1 (relative to the free lever's at its resonance)",
-                   "amplitude": "m", "energy_dissipated": "J", "virial": "J", "min_distance": "m", "peak_force": "N", "spring_constant": "N/m"})
-        } else {
-            json!({"z_c": "g0", "frequency_shift": "Ω (units of the τ scale)", "frequency": "Ω", "excitation": "1 (relative)",
-                   "amplitude": "g0", "energy_dissipated": "F·g0", "virial": "F·g0", "min_distance": "g0", "peak_force": "F"})
-        },
-        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/afm-workflow.md)",
-        "warnings": warnings,
-    })
+    warnings
 }
 
-/// Where a variable of the FM layout takes its unit: the document's `units` under a key, or
-/// a unit of its own.
-#[derive(Debug, Clone, Copy)]
-enum Unit {
-    /// `units[key]` of the document ([`document`]): its length, frequency, force, energy.
-    Of(&'static str),
-    /// A unit the document does not name (`1` a pure number, `""` a flag).
-    Is(&'static str),
-}
-
-/// The variables of an FM curve's layout ([`layout`]) after `z_c`, in the table's order
-/// (`fm.csv`, [`super::present::fm::COLUMNS`]): name, unit, long name.
-const FM_VARIABLES: [(&str, Unit, &str); 17] = [
-    (
-        "frequency_shift",
-        Unit::Of("frequency_shift"),
-        "frequency shift Δf = f − f_K",
-    ),
-    (
-        "frequency",
-        Unit::Of("frequency"),
-        "drive frequency the PLL locks at",
-    ),
-    (
-        "excitation",
-        Unit::Of("excitation"),
-        "excitation relative to the free lever's at its resonance",
-    ),
-    (
-        "amplitude",
-        Unit::Of("amplitude"),
-        "first-harmonic amplitude A1",
-    ),
-    (
-        "phase_deg",
-        Unit::Is("deg"),
-        "lag of the first harmonic behind the drive",
-    ),
-    (
-        "energy_dissipated",
-        Unit::Of("energy_dissipated"),
-        "energy dissipated in the sample per cycle",
-    ),
-    ("virial", Unit::Of("virial"), "virial ⟨F_c W⟩"),
-    ("mean_deflection", Unit::Of("z_c"), "mean deflection"),
-    (
-        "min_distance",
-        Unit::Of("min_distance"),
-        "tip–sample distance at the lower turning point",
-    ),
-    (
-        "peak_force",
-        Unit::Of("peak_force"),
-        "largest tip–sample force",
-    ),
-    (
-        "mean_force",
-        Unit::Of("peak_force"),
-        "mean tip–sample force",
-    ),
-    (
-        "law_force",
-        Unit::Of("peak_force"),
-        "the law's conservative force at the lower turning point",
-    ),
-    ("indentation", Unit::Of("z_c"), "largest indentation"),
-    (
-        "max_multiplier",
-        Unit::Is("1"),
-        "largest Floquet multiplier modulus under the locked drive",
-    ),
-    (
-        "stable",
-        Unit::Is(""),
-        "Floquet-stable under the locked drive",
-    ),
-    (
-        "loop_residual",
-        Unit::Is("1"),
-        "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
-    ),
-    ("iterations", Unit::Is("1"), "Newton iterations on (Ω, α2)"),
-];
-
-/// The layout of an FM curve's document `doc` ([`document`]): over `z_c` (the rest distance,
-/// its coordinate) every array of its `curve`, in the document's units (SI with a probe, the
-/// model's without: `units`; `deg` for the phase, `1` for the pure numbers, the length's and
-/// force's units for the mean deflection and indentation, and for the mean and law forces);
-/// `stable` flags, `iterations` integers, `null` as NaN. What Python's `afmdyn.fm` returns.
-pub fn layout(doc: &Value) -> crate::layout::Layout {
-    use crate::layout::{Layout, Values, Variable};
-    let curve = &doc["curve"];
-    let list = |name: &str| curve[name].as_array().cloned().unwrap_or_default();
-    let numbers = |name: &str| -> Vec<f64> {
-        let v = list(name);
-        v.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()
-    };
-    let unit = |u: Unit| match u {
-        Unit::Of(key) => doc["units"][key].as_str().unwrap_or_default().to_string(),
-        Unit::Is(u) => u.to_string(),
-    };
-    let z_c = numbers("z_c");
-    let mut variables = vec![Variable::f64(
-        "z_c",
+/// The layout of an FM curve: over `z_c` (the rest distance, its coordinate) every column of
+/// `COLUMNS`, in the document's units (SI with a probe, the model's without; `deg` for the
+/// phase, `1` for the pure numbers); `stable` flags, `iterations` integers. What Python's
+/// `afmdyn.fm` returns.
+pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
+    let frame = Frame::new(model, curve);
+    let p = &curve.points;
+    let variables = columns::variables(
+        &COLUMNS,
+        &frame,
+        p,
         &["z_c"],
-        &unit(Unit::Of("z_c")),
-        "rest distance z_c",
-        &z_c,
-    )];
-    for (name, u, long_name) in FM_VARIABLES {
-        let values = match name {
-            "stable" => Values::Bool(
-                list(name)
-                    .iter()
-                    .map(|x| x.as_bool() == Some(true))
-                    .collect(),
-            ),
-            "iterations" => Values::I32(
-                list(name)
-                    .iter()
-                    .map(|x| x.as_i64().map_or(-1, |i| i as i32))
-                    .collect(),
-            ),
-            _ => Values::F64(numbers(name)),
-        };
-        variables.push(Variable::new(name, &["z_c"], &unit(u), long_name, values));
-    }
-    Layout::new("fm", &[("z_c", z_c.len())], variables)
+        &UnitNames::si_or_model(frame.u.si),
+    );
+    crate::layout::Layout::new("fm", &[("z_c", p.len())], variables)
+}
+
+/// The table of an FM curve (`fm.csv`): the names of `COLUMNS` and one row per z_c reached
+/// (`stable` as 1/0).
+pub fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
+    let frame = Frame::new(model, curve);
+    let rows = columns::rows(&COLUMNS, &frame, &curve.points);
+    (columns::names(&COLUMNS), rows)
 }

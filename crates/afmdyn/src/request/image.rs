@@ -37,6 +37,7 @@ use crate::analysis::approach::approach_retract;
 use crate::analysis::setpoint::operating_points;
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
+use crate::layout::columns::{self, columns, Column};
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
@@ -246,6 +247,33 @@ pub struct Image {
     /// What the image cannot show as asked.
     pub warnings: Vec<String>,
 }
+
+/// A pixel of an image: (line, pixel).
+pub(crate) type Cell = (usize, usize);
+
+/// The numeric maps of an image over (y, x), in SI (NaN, `null` in the document, where the
+/// setpoint is not reached): the document's `image` block ([`Image::document`]) and the
+/// variables of its layout (`image.nc`, Python's Dataset), in this order.
+pub(crate) const FIELDS: [Column<Image, Cell>; 9] = columns! {
+    "height", Length, false, "apparent height h + z_c − z_c,ref (ideal feedback)",
+        F64(|g, &(j, i)| g.apparent_height(j, i));
+    "true_height", Length, false, "true height of the sample map",
+        F64(|g, &(j, i)| g.pixels[j][i].height);
+    "z_c", Length, false, "rest distance z_c the feedback holds",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.z_c));
+    "amplitude", Length, false, "amplitude (the setpoint where reached)",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.amplitude));
+    "phase_deg", Fixed("degree"), false, "phase lag behind the drive",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.phase_deg));
+    "energy_dissipated", Energy, false, "energy dissipated per drive period",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.energy_dissipated));
+    "virial", Energy, false, "virial of the tip–sample force",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.virial));
+    "peak_force", Force, false, "largest tip–sample force",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.peak_force));
+    "indentation", Length, false, "largest indentation",
+        Opt(|g, &(j, i)| Some(g.point(j, i)?.indentation));
+};
 
 impl ImageRequest {
     /// Check the request against the map.
@@ -670,15 +698,15 @@ impl Image {
     }
 
     /// The image document (`afmdyn image --json`): `image` with `x`, `y` (m) and per
-    /// `[line][pixel]` `height` (apparent, m), `true_height` (m), `amplitude` (m), `phase_deg`,
-    /// `energy_dissipated` (J), `virial` (J), `peak_force` (N), `indentation` (m), `z_c` (m),
-    /// `regime`, `material` and `domain` (their names); `materials` with their operating points;
-    /// `reference_z_c` (m), `setpoint`, `warnings`.
+    /// `[line][pixel]` the `FIELDS` (null where not reached), `regime`, `material` and
+    /// `domain` (their names); `materials` with their operating points; `reference_z_c` (m),
+    /// `setpoint`, `warnings`.
     pub fn document(&self, setpoint: f64) -> Value {
+        let shape = (self.y.len(), self.x.len());
         let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
             Value::Array(
-                (0..self.y.len())
-                    .map(|j| Value::Array((0..self.x.len()).map(|i| f(j, i)).collect()))
+                (0..shape.0)
+                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
                     .collect(),
             )
         };
@@ -689,34 +717,25 @@ impl Image {
                 Value::Null
             }
         };
-        let field = |get: fn(&OperatingPoint) -> f64| {
-            grid(&|j, i| num(self.point(j, i).map_or(f64::NAN, get)))
-        };
+        let mut image = columns::grids(&FIELDS, self, &columns::cells(shape), shape);
+        image.insert("x".into(), serde_json::json!(self.x));
+        image.insert("y".into(), serde_json::json!(self.y));
+        let regime = grid(&|j, i| {
+            self.point(j, i)
+                .map_or(Value::Null, |o| serde_json::json!(o.regime))
+        });
+        image.insert("regime".into(), regime);
+        let material =
+            grid(&|j, i| serde_json::json!(self.materials[self.pixels[j][i].material].name));
+        image.insert("material".into(), material);
+        let domain = grid(&|j, i| {
+            serde_json::json!(self.pixels[j][i]
+                .domain
+                .map_or("background", |k| { self.domain_names[k].as_str() }))
+        });
+        image.insert("domain".into(), domain);
         serde_json::json!({
-            "image": {
-                "x": self.x,
-                "y": self.y,
-                "height": grid(&|j, i| num(self.apparent_height(j, i))),
-                "true_height": grid(&|j, i| num(self.pixels[j][i].height)),
-                "z_c": field(|o| o.z_c),
-                "amplitude": field(|o| o.amplitude),
-                "phase_deg": field(|o| o.phase_deg),
-                "energy_dissipated": field(|o| o.energy_dissipated),
-                "virial": field(|o| o.virial),
-                "peak_force": field(|o| o.peak_force),
-                "indentation": field(|o| o.indentation),
-                "regime": grid(&|j, i| {
-                    self.point(j, i).map_or(Value::Null, |o| serde_json::json!(o.regime))
-                }),
-                "material": grid(&|j, i| {
-                    serde_json::json!(self.materials[self.pixels[j][i].material].name)
-                }),
-                "domain": grid(&|j, i| {
-                    serde_json::json!(self.pixels[j][i].domain.map_or("background", |k| {
-                        self.domain_names[k].as_str()
-                    }))
-                }),
-            },
+            "image": image,
             "feedback": "ideal",
             "setpoint": setpoint,
             "reference_z_c": num(self.reference),

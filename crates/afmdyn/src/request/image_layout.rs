@@ -4,32 +4,14 @@
 //! ideal-feedback image ([`crate::request::image::Image`], [`layout`]) and the PI scan
 //! ([`crate::request::image_scan::PiImage`], [`scan_layout`]).
 
-use super::image::{Image, OperatingPoint, Regime};
+use super::image::{Image, Regime, FIELDS};
 use super::image_peakforce::{PeakForceImage, PF_FIELDS};
-use super::image_scan::PiImage;
+use super::image_scan::{scan_cells, PiImage, SCAN_FIELDS};
+use crate::layout::columns::{self, UnitNames};
 use crate::layout::{Attr, Layout, Values, Variable};
 
-/// The numeric maps of an image over (y, x): name, units, long name, as the JSON document's
-/// `image` block names them ([`Image::document`]).
-pub const FIELDS: [(&str, &str, &str); 9] = [
-    (
-        "height",
-        "m",
-        "apparent height h + z_c − z_c,ref (ideal feedback)",
-    ),
-    ("true_height", "m", "true height of the sample map"),
-    ("z_c", "m", "rest distance z_c the feedback holds"),
-    ("amplitude", "m", "amplitude (the setpoint where reached)"),
-    ("phase_deg", "degree", "phase lag behind the drive"),
-    (
-        "energy_dissipated",
-        "J",
-        "energy dissipated per drive period",
-    ),
-    ("virial", "J", "virial of the tip–sample force"),
-    ("peak_force", "N", "largest tip–sample force"),
-    ("indentation", "m", "largest indentation"),
-];
+/// The names of the images' units: SI.
+const SI: UnitNames = UnitNames::si_or_model(true);
 
 /// The codes of `regime`: 0 where the setpoint is not reached, 1 attractive, 2 repulsive (CF
 /// `flag_values` and `flag_meanings`).
@@ -97,7 +79,7 @@ fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
 }
 
 /// The image's layout: coordinates `x`, `y` (m: pixel centres and line positions); over
-/// (y, x) the [`FIELDS`] as 64-bit floats in SI (NaN where the setpoint is not reached),
+/// (y, x) the `FIELDS` as 64-bit floats in SI (NaN where the setpoint is not reached),
 /// `regime` (codes [`REGIME_FLAGS`]), `material` (index into the image's materials, 0 the
 /// background) and `domain` (0 the background, k the map's k-th domain), each 32-bit integer
 /// codes with their CF `flag_values` and `flag_meanings`; the scalars `setpoint` (A_sp/A₀, as
@@ -105,30 +87,12 @@ fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
 pub fn layout(img: &Image, setpoint: f64) -> Layout {
     let (nx, ny) = (img.x.len(), img.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
-    let point = |get: fn(&OperatingPoint) -> f64| -> Vec<f64> {
-        cells()
-            .map(|(j, i)| img.point(j, i).map_or(f64::NAN, get))
-            .collect()
-    };
-    let grid: &[&str] = &["y", "x"];
     let mut variables = vec![
         Variable::f64("x", &["x"], "m", "pixel centre x", &img.x),
         Variable::f64("y", &["y"], "m", "line position y", &img.y),
     ];
-    for (name, units, long_name) in FIELDS {
-        let values = match name {
-            "height" => cells().map(|(j, i)| img.apparent_height(j, i)).collect(),
-            "true_height" => cells().map(|(j, i)| img.pixels[j][i].height).collect(),
-            "z_c" => point(|o| o.z_c),
-            "amplitude" => point(|o| o.amplitude),
-            "phase_deg" => point(|o| o.phase_deg),
-            "energy_dissipated" => point(|o| o.energy_dissipated),
-            "virial" => point(|o| o.virial),
-            "peak_force" => point(|o| o.peak_force),
-            _ => point(|o| o.indentation),
-        };
-        variables.push(Variable::f64(name, grid, units, long_name, &values));
-    }
+    let fields = &columns::cells((ny, nx));
+    variables.extend(columns::variables(&FIELDS, img, fields, &["y", "x"], &SI));
     let regime: Vec<i32> = cells()
         .map(|(j, i)| match img.point(j, i).map(|o| o.regime) {
             None => REGIME_FLAGS[0].0,
@@ -163,44 +127,7 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
     )
 }
 
-/// The recorded maps of a PI scan over (y, x), trace and `_retrace`: name, units, long name,
-/// as the document's `image` block names them ([`PiImage::document`]).
-pub const SCAN_FIELDS: [(&str, &str, &str); 8] = [
-    (
-        "height",
-        "m",
-        "recorded height: the mean piezo position less the ideal reference z_c,ref",
-    ),
-    ("amplitude", "m", "mean lock-in amplitude"),
-    (
-        "phase_deg",
-        "degree",
-        "mean lock-in phase lag behind the drive",
-    ),
-    (
-        "tracking_error",
-        "m",
-        "mean amplitude error A_sp − A (the error image)",
-    ),
-    (
-        "energy_dissipated",
-        "J",
-        "energy dissipated over the pixel's last drive period",
-    ),
-    ("virial", "J", "virial over the pixel's last drive period"),
-    (
-        "peak_force",
-        "N",
-        "largest tip–sample force over the pixel's last drive period",
-    ),
-    (
-        "indentation",
-        "m",
-        "largest indentation over the pixel's last drive period",
-    ),
-];
-
-/// The PI scan's layout: coordinates `x`, `y` (m); over (y, x) the [`SCAN_FIELDS`] of the
+/// The PI scan's layout: coordinates `x`, `y` (m); over (y, x) the `SCAN_FIELDS` of the
 /// trace and, suffixed `_retrace`, of the retrace (64-bit floats in SI), `lost_contact` and
 /// `lost_contact_retrace` (flags), `regime` and `material` of each direction (codes as in
 /// [`layout`]), `ideal_height` (m, the ideal image's apparent height), `true_height` (m) and
@@ -286,8 +213,6 @@ fn direction_variables(img: &PiImage, d: usize, suffix: &str) -> Vec<Variable> {
     let (nx, ny) = (g.x.len(), g.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
     let grid: &[&str] = &["y", "x"];
-    let (m, e, f) = (img.length(), img.energy(), img.force());
-    let mut variables = Vec::new();
     let pixel = |j: usize, i: usize| {
         if d == 0 {
             &img.lines[j].trace[i]
@@ -295,38 +220,11 @@ fn direction_variables(img: &PiImage, d: usize, suffix: &str) -> Vec<Variable> {
             &img.lines[j].retrace[i]
         }
     };
-    for (name, units, long_name) in SCAN_FIELDS {
-        let values: Vec<f64> = cells()
-            .map(|(j, i)| {
-                let p = pixel(j, i);
-                match name {
-                    "height" => img.height(d, j, i),
-                    "amplitude" => p.amplitude * m,
-                    "phase_deg" => p.phase.to_degrees(),
-                    "tracking_error" => p.tracking_error * m,
-                    "energy_dissipated" => p.energy_dissipated * e,
-                    "virial" => p.virial * e,
-                    "peak_force" => p.peak_force * f,
-                    _ => p.indentation * m,
-                }
-            })
-            .collect();
-        variables.push(Variable::f64(
-            &format!("{name}{suffix}"),
-            grid,
-            units,
-            long_name,
-            &values,
-        ));
+    let fields = &scan_cells(d, (ny, nx));
+    let mut variables = columns::variables(&SCAN_FIELDS, img, fields, grid, &SI);
+    for v in &mut variables {
+        v.name.push_str(suffix);
     }
-    let lost: Vec<bool> = cells().map(|(j, i)| pixel(j, i).lost_contact).collect();
-    variables.push(Variable::new(
-        &format!("lost_contact{suffix}"),
-        grid,
-        "1",
-        "the controller lost contact (parachuting) in the pixel's last drive period",
-        Values::Bool(lost),
-    ));
     let regime: Vec<i32> = cells()
         .map(|(j, i)| {
             if crate::report::regime(pixel(j, i).mean_deflection) == "attractive" {
@@ -359,10 +257,8 @@ pub(crate) fn peakforce_layout(img: &PeakForceImage) -> Layout {
         Variable::f64("x", &["x"], "m", "pixel centre x", &img.x),
         Variable::f64("y", &["y"], "m", "line position y", &img.y),
     ];
-    for (name, units, long_name) in PF_FIELDS {
-        let values: Vec<f64> = cells().map(|(j, i)| img.value(name, j, i)).collect();
-        variables.push(Variable::f64(name, grid, units, long_name, &values));
-    }
+    let fields = &columns::cells((ny, nx));
+    variables.extend(columns::variables(&PF_FIELDS, img, fields, grid, &SI));
     let evaluations: Vec<i32> = cells()
         .map(|(j, i)| img.pixels[j][i].evaluations as i32)
         .collect();

@@ -34,7 +34,7 @@
 //! does not depend on the thread count or the executor.
 
 use super::costs::{newton_work, steady_periods, MODEL_BYTES};
-use super::image::{background_probe, material_models, pixel_grid, ImageRequest, SampleMap};
+use super::image::{background_probe, material_models, pixel_grid, Cell, ImageRequest, SampleMap};
 use super::limits::Cost;
 use super::peakforce::modulus_scale;
 use super::run::Resolved;
@@ -43,6 +43,7 @@ use crate::analysis::peakforce::{
     SteadyTap, BRACKET_STEPS, SETPOINT_ITERATIONS, SETPOINT_TOL,
 };
 use crate::error::SimError;
+use crate::layout::columns::{self, columns, Column};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::probe::Probe;
@@ -621,35 +622,29 @@ impl PeakForceImageStudy {
     }
 }
 
-/// The numeric maps of a PeakForce image over (y, x): name, units, long name, as its document's
-/// `image` block and `image.nc` name them.
-pub const PF_FIELDS: [(&str, &str, &str); 9] = [
-    (
-        "height",
-        "m",
-        "apparent height h + z_c − z_c,ref (ideal peak-force feedback)",
-    ),
-    ("true_height", "m", "true height of the sample map"),
-    ("z_c", "m", "mean rest separation z_c the feedback holds"),
-    ("peak_force", "N", "peak force (the setpoint where reached)"),
-    (
-        "modulus_dmt",
-        "Pa",
-        "reduced modulus E* of the DMT fit of the retract curve (PF-QNM)",
-    ),
-    (
-        "adhesion",
-        "N",
-        "adhesion: the most negative tip–sample force",
-    ),
-    ("deformation", "m", "deformation: the largest indentation"),
-    (
-        "dissipation",
-        "J",
-        "tip–sample dissipation per modulation period",
-    ),
-    ("taps_per_cycle", "1", "contacts per modulation period"),
-];
+/// The numeric maps of a PeakForce image over (y, x), in SI (NaN, `null` in the document,
+/// where the setpoint is not reached): its document's `image` block and the variables of
+/// `image.nc`, in this order.
+pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
+    "height", Length, false, "apparent height h + z_c − z_c,ref (ideal peak-force feedback)",
+        Opt(|g, &(j, i)| Some(g.true_height[j][i] + g.tap(j, i)?.z_c - g.reference));
+    "true_height", Length, false, "true height of the sample map",
+        F64(|g, &(j, i)| g.true_height[j][i]);
+    "z_c", Length, false, "mean rest separation z_c the feedback holds",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.z_c));
+    "peak_force", Force, false, "peak force (the setpoint where reached)",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.peak_force));
+    "modulus_dmt", Fixed("Pa"), false, "reduced modulus E* of the DMT fit of the retract curve (PF-QNM)",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.modulus_dmt));
+    "adhesion", Force, false, "adhesion: the most negative tip–sample force",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.adhesion));
+    "deformation", Length, false, "deformation: the largest indentation",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.deformation));
+    "dissipation", Energy, false, "tip–sample dissipation per modulation period",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.dissipation));
+    "taps_per_cycle", Fixed("1"), false, "contacts per modulation period",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.taps_per_cycle));
+};
 
 impl PeakForceImage {
     /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
@@ -657,49 +652,31 @@ impl PeakForceImage {
         self.pixels[line][pixel].tap.as_ref()
     }
 
-    /// The value of the map `name` ([`PF_FIELDS`]) at (line, pixel) (NaN where not reached or
+    /// The value of the map `name` (`PF_FIELDS`) at (line, pixel) (NaN where not reached or
     /// an unknown name).
     pub fn value(&self, name: &str, line: usize, pixel: usize) -> f64 {
-        if name == "true_height" {
-            return self.true_height[line][pixel];
-        }
-        let Some(t) = self.tap(line, pixel) else {
-            return f64::NAN;
-        };
-        match name {
-            "height" => self.true_height[line][pixel] + t.z_c - self.reference,
-            "z_c" => t.z_c,
-            "peak_force" => t.peak_force,
-            "modulus_dmt" => t.modulus_dmt,
-            "adhesion" => t.adhesion,
-            "deformation" => t.deformation,
-            "dissipation" => t.dissipation,
-            "taps_per_cycle" => t.taps_per_cycle,
-            _ => f64::NAN,
-        }
+        let field = PF_FIELDS.iter().find(|c| c.name == name);
+        field.map_or(f64::NAN, |c| c.number(self, &(line, pixel)))
     }
 
     /// The image document (`afmdyn image --mode peakforce --json`): `image` with `x`, `y` (m)
-    /// and per `[line][pixel]` the [`PF_FIELDS`] (SI; null where not reached), `evaluations`,
+    /// and per `[line][pixel]` the `PF_FIELDS` (SI; null where not reached), `evaluations`,
     /// `material` and `domain` (names); `mode` `"peakforce"`, `feedback` `"ideal"`, `setpoint`
     /// (N), `reference_z_c` (m), `materials` (each with its true modulus and engaged operating
     /// point), `taps` (steady taps computed), `warnings`.
     pub fn document(&self) -> Value {
         use serde_json::json;
-        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+        let shape = (self.y.len(), self.x.len());
         let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
             Value::Array(
-                (0..self.y.len())
-                    .map(|j| Value::Array((0..self.x.len()).map(|i| f(j, i)).collect()))
+                (0..shape.0)
+                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
                     .collect(),
             )
         };
-        let mut image = serde_json::Map::new();
+        let mut image = columns::grids(&PF_FIELDS, self, &columns::cells(shape), shape);
         image.insert("x".into(), json!(self.x));
         image.insert("y".into(), json!(self.y));
-        for (name, _, _) in PF_FIELDS {
-            image.insert(name.into(), grid(&|j, i| num(self.value(name, j, i))));
-        }
         image.insert(
             "evaluations".into(),
             grid(&|j, i| json!(self.pixels[j][i].evaluations)),

@@ -41,6 +41,7 @@ use crate::analysis::am_loop::{
 use crate::analysis::approach::rest_distance;
 use crate::error::{number, SimError};
 use crate::integrate::IntegratorOptions;
+use crate::layout::columns::{self, columns, Column};
 use crate::probe::Probe;
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
@@ -552,6 +553,41 @@ fn empty_artefacts() -> Artefacts {
     }
 }
 
+/// A pixel of a PI scan: (direction: 0 the trace, 1 the retrace; line; pixel).
+pub(crate) type ScanCell = (usize, usize, usize);
+
+/// The recorded maps of a PI scan over (y, x) in SI, each direction's: the document's `image`
+/// and `retrace` blocks ([`PiImage::document`]) and the variables of its layout (the
+/// retrace's suffixed `_retrace`), in this order.
+pub(crate) const SCAN_FIELDS: [Column<PiImage, ScanCell>; 9] = columns! {
+    "height", Length, false,
+        "recorded height: the mean piezo position less the ideal reference z_c,ref",
+        F64(|g, &(d, j, i)| g.height(d, j, i));
+    "amplitude", Length, false, "mean lock-in amplitude",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].amplitude * g.units.length);
+    "phase_deg", Fixed("degree"), false, "mean lock-in phase lag behind the drive",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].phase.to_degrees());
+    "tracking_error", Length, false, "mean amplitude error A_sp − A (the error image)",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].tracking_error * g.units.length);
+    "energy_dissipated", Energy, false, "energy dissipated over the pixel's last drive period",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].energy_dissipated * g.units.energy);
+    "virial", Energy, false, "virial over the pixel's last drive period",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].virial * g.units.energy);
+    "peak_force", Force, false, "largest tip–sample force over the pixel's last drive period",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].peak_force * g.units.force);
+    "indentation", Length, false, "largest indentation over the pixel's last drive period",
+        F64(|g, &(d, j, i)| g.row(d, j)[i].indentation * g.units.length);
+    "lost_contact", Fixed("1"), false,
+        "the controller lost contact (parachuting) in the pixel's last drive period",
+        Bool(|g, &(d, j, i)| g.row(d, j)[i].lost_contact);
+};
+
+/// The cells of direction `d` of a scan of `shape` (lines, pixels), line by line.
+pub(crate) fn scan_cells(d: usize, shape: (usize, usize)) -> Vec<ScanCell> {
+    let cells = crate::layout::columns::cells(shape).into_iter();
+    cells.map(|(j, i)| (d, j, i)).collect()
+}
+
 impl PiImage {
     /// Metres per model length unit g₀ (the records' lengths).
     pub fn length(&self) -> f64 {
@@ -641,39 +677,27 @@ impl PiImage {
     /// `materials`, `reference_z_c` (m), `setpoint`, `warnings`.
     pub fn document(&self, setpoint: f64) -> Value {
         let ideal = self.ideal.document(setpoint);
-        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
         let (ny, nx) = (self.lines.len(), self.ideal.x.len());
-        let u = self.units;
-        let grid = |d: usize, f: &dyn Fn(usize, usize, &ScanPixel) -> Value| -> Value {
-            Value::Array(
-                (0..ny)
-                    .map(|j| Value::Array((0..nx).map(|i| f(j, i, &self.row(d, j)[i])).collect()))
-                    .collect(),
-            )
+        let grid = |d: usize, f: &dyn Fn(&ScanPixel) -> Value| -> Value {
+            let line = |j| Value::Array(self.row(d, j).iter().take(nx).map(f).collect());
+            Value::Array((0..ny).map(line).collect())
         };
         let recorded = |d: usize| {
-            json!({
-                "height": grid(d, &|j, i, _| num(self.height(d, j, i))),
-                "amplitude": grid(d, &|_, _, p| num(p.amplitude * u.length)),
-                "phase_deg": grid(d, &|_, _, p| num(p.phase.to_degrees())),
-                "tracking_error": grid(d, &|_, _, p| num(p.tracking_error * u.length)),
-                "energy_dissipated": grid(d, &|_, _, p| num(p.energy_dissipated * u.energy)),
-                "virial": grid(d, &|_, _, p| num(p.virial * u.energy)),
-                "peak_force": grid(d, &|_, _, p| num(p.peak_force * u.force)),
-                "indentation": grid(d, &|_, _, p| num(p.indentation * u.length)),
-                "regime": grid(d, &|_, _, p| json!(crate::report::regime(p.mean_deflection))),
-                "lost_contact": grid(d, &|_, _, p| json!(p.lost_contact)),
-                "material": grid(d, &|_, _, p| json!(self.ideal.materials[p.material].name)),
-            })
+            let mut m = columns::grids(&SCAN_FIELDS, self, &scan_cells(d, (ny, nx)), (ny, nx));
+            let regime = grid(d, &|p| json!(crate::report::regime(p.mean_deflection)));
+            m.insert("regime".into(), regime);
+            let material = grid(d, &|p| json!(self.ideal.materials[p.material].name));
+            m.insert("material".into(), material);
+            m
         };
         let mut image = recorded(0);
-        let m = image.as_object_mut().expect("an object");
+        let m = &mut image;
         m.insert("x".into(), json!(self.ideal.x));
         m.insert("y".into(), json!(self.ideal.y));
         m.insert("ideal_height".into(), ideal["image"]["height"].clone());
         m.insert("true_height".into(), ideal["image"]["true_height"].clone());
         m.insert("domain".into(), ideal["image"]["domain"].clone());
-        m.insert("retrace".into(), recorded(1));
+        m.insert("retrace".into(), Value::Object(recorded(1)));
         json!({
             "image": image,
             "feedback": "pi",

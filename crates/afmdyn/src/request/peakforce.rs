@@ -511,17 +511,9 @@ fn sweep_block(
     has_radius: bool,
     warnings: &mut Vec<String>,
 ) -> Option<Value> {
-    let u = PeakForceRequest::units(model);
-    let sweep = request
-        .sweep
-        .as_ref()
-        .zip(r.sweep.as_ref())
-        .map(|(s, taps)| {
-            let scale = true_modulus(model, 1.0)
-                .filter(|_| has_radius)
-                .unwrap_or(1.0);
-            super::peakforce_sweep::sweep_document(s, &u, Some(scale), taps)
-        });
+    let frame = sweep_frame(model, has_radius);
+    let sweep = request.sweep.as_ref().zip(r.sweep.as_ref());
+    let sweep = sweep.map(|(s, taps)| super::peakforce_sweep::sweep_document(s, &frame, taps));
     if let (Some(block), Some(taps)) = (&sweep, &r.sweep) {
         warnings.extend(super::peakforce_sweep::sweep_warnings(block, taps));
         let failed = block["message"]
@@ -535,6 +527,17 @@ fn sweep_block(
         }
     }
     sweep
+}
+
+/// What a sweep's channels are read through: the document's units, and the modulus in Pa (with a
+/// probe, for a law with a tip radius `has_radius`) or as the Hertz group.
+fn sweep_frame(model: &Resolved, has_radius: bool) -> super::peakforce_sweep::Frame {
+    super::peakforce_sweep::Frame {
+        u: PeakForceRequest::units(model),
+        modulus_scale: true_modulus(model, 1.0)
+            .filter(|_| has_radius)
+            .unwrap_or(1.0),
+    }
 }
 
 /// The document's `units`: SI with a probe, else the model's.
@@ -641,11 +644,11 @@ impl super::named::Datasets for PeakForceRequest {
         );
         let facts = doc["channels"].as_object().cloned().unwrap_or_default();
         let mut layouts = vec![("cycle".into(), cycle), ("curve".into(), curve)];
-        if !doc["sweep"].is_null() {
-            layouts.push((
-                "sweep".into(),
-                super::peakforce_sweep::sweep_layout(&doc["sweep"]),
-            ));
+        if let Some((s, taps)) = self.sweep.as_ref().zip(r.sweep.as_ref()) {
+            // the contact law, and so its tip radius, is the same at every value of a sweep
+            let frame = sweep_frame(model, model.params.contact_law.info().tip_radius);
+            let layout = super::peakforce_sweep::sweep_layout(s, &frame, taps);
+            layouts.push(("sweep".into(), layout));
         }
         Ok((layouts, facts))
     }

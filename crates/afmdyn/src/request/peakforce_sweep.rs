@@ -5,6 +5,7 @@
 
 use crate::analysis::peakforce::SteadyTap;
 use crate::error::SimError;
+use crate::layout::columns::{self, columns, Column, UnitNames};
 use crate::layout::{Layout, Values, Variable};
 use crate::params::Params;
 use crate::report::CurveUnits;
@@ -105,112 +106,60 @@ impl PeakForceSweep {
     }
 }
 
-/// A channel of a sweep's tap as reported (`None`: the point failed).
-type Channel = fn(&SweepTap, &CurveUnits) -> Option<f64>;
-
-/// The channels of the sweep's document and layout: (name, unit kind, long name, value).
-const CHANNELS: [(&str, &str, &str, Channel); 9] = [
-    ("peak_force", "force", "peak force", |t, u| {
-        t.tap.as_ref().map(|t| t.channels.peak_force * u.force)
-    }),
-    (
-        "adhesion",
-        "force",
-        "adhesion (most negative force)",
-        |t, u| t.tap.as_ref().map(|t| t.channels.adhesion * u.force),
-    ),
-    ("deformation", "length", "largest indentation", |t, u| {
-        t.tap.as_ref().map(|t| t.channels.deformation * u.length)
-    }),
-    (
-        "dissipation",
-        "energy",
-        "tip-sample work per cycle",
-        |t, u| t.tap.as_ref().map(|t| t.channels.dissipation * u.energy),
-    ),
-    (
-        "contact_time",
-        "time",
-        "time in contact per cycle",
-        |t, u| t.tap.as_ref().map(|t| t.channels.contact_time * u.time),
-    ),
-    (
-        "snap_off_time",
-        "time",
-        "snap-off from the largest separation",
-        |t, u| t.tap.as_ref().map(|t| t.channels.snap_off_time * u.time),
-    ),
-    (
-        "ringing_amplitude",
-        "length",
-        "ringing after snap-off",
-        |t, u| {
-            t.tap
-                .as_ref()
-                .map(|t| t.channels.ringing_amplitude * u.length)
-        },
-    ),
-    (
-        "taps_per_cycle",
-        "1",
-        "contacts per modulation period",
-        |t, _| t.tap.as_ref().map(|t| t.channels.taps_per_cycle),
-    ),
-    ("z_c", "length", "mean rest separation", |t, u| {
-        Some(t.params.rest_distance() * u.length)
-    }),
-];
-
-/// The unit of a kind under `u`.
-fn unit(kind: &str, si: bool) -> &'static str {
-    match (kind, si) {
-        ("force", true) => "N",
-        ("force", false) => "F",
-        ("length", true) => "m",
-        ("length", false) => "g0",
-        ("energy", true) => "J",
-        ("energy", false) => "F·g0",
-        ("time", true) => "s",
-        ("time", false) => "τ",
-        ("modulus", true) => "Pa",
-        ("modulus", false) => "α4 (Hertz group)",
-        _ => "1",
-    }
+/// What a sweep's columns ([`COLUMNS`]) are read through: the document's units and the factor
+/// from the fitted Hertz group to the reported modulus (the reduced modulus in Pa with a probe
+/// and a law with a tip radius, else 1).
+pub(crate) struct Frame {
+    /// The document's units.
+    pub u: CurveUnits,
+    /// Reported modulus per unit of the Hertz group.
+    pub modulus_scale: f64,
 }
 
-/// The `sweep` block of the document: the swept quantity and its values, each channel (and
-/// `z_c`, the feedback's with a setpoint) over them (`null` where a point failed), the fitted
-/// modulus `modulus_dmt` (`modulus_scale` × the fitted Hertz group: the reduced modulus in Pa
-/// with a probe), the orbit's period and stability, and each point's message (`null` when
-/// computed).
-pub(crate) fn sweep_document(
-    sweep: &PeakForceSweep,
-    u: &CurveUnits,
-    modulus_scale: Option<f64>,
-    taps: &[SweepTap],
-) -> Value {
-    let mut channels = serde_json::Map::new();
-    let mut units = serde_json::Map::new();
-    for (name, kind, _, f) in CHANNELS {
-        let v: Vec<Option<f64>> = taps.iter().map(|t| f(t, u)).collect();
-        channels.insert(name.into(), json!(v));
-        units.insert(name.into(), json!(unit(kind, u.si)));
-    }
-    let modulus: Vec<Option<f64>> = taps
-        .iter()
-        .map(|t| {
-            let k = t.tap.as_ref()?.fit?.hertz_group;
-            modulus_scale.map(|s| k * s)
-        })
-        .collect();
-    channels.insert("modulus_dmt".into(), json!(modulus));
-    units.insert("modulus_dmt".into(), json!(unit("modulus", u.si)));
+/// The channels of a sweep, one entry per value (missing where the point failed): the
+/// document's `sweep.channels` and `sweep.units`, the layout's variables and the columns of the
+/// table `peakforce-sweep.csv` after the swept value, in this order (the layout lists
+/// `modulus_dmt` last, [`sweep_layout`]).
+const COLUMNS: [Column<Frame, SweepTap>; 10] = columns! {
+    "peak_force", Force, true, "peak force",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.peak_force * f.u.force));
+    "adhesion", Force, true, "adhesion (most negative force)",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.adhesion * f.u.force));
+    "deformation", Length, true, "largest indentation",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.deformation * f.u.length));
+    "dissipation", Energy, true, "tip-sample work per cycle",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.dissipation * f.u.energy));
+    "contact_time", Own("s", "τ"), true, "time in contact per cycle",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.contact_time * f.u.time));
+    "snap_off_time", Own("s", "τ"), true, "snap-off from the largest separation",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.snap_off_time * f.u.time));
+    "ringing_amplitude", Length, true, "ringing after snap-off",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.ringing_amplitude * f.u.length));
+    "modulus_dmt", Own("Pa", "α4 (Hertz group)"), true, "fitted DMT modulus of the retract (PF-QNM)",
+        Opt(|f, t| Some(t.tap.as_ref()?.fit?.hertz_group * f.modulus_scale));
+    "taps_per_cycle", Fixed("1"), true, "contacts per modulation period",
+        Opt(|_, t| Some(t.tap.as_ref()?.channels.taps_per_cycle));
+    "z_c", Length, true, "mean rest separation",
+        Opt(|f, t| Some(t.params.rest_distance() * f.u.length));
+};
+
+/// The names of a sweep's channels ([`COLUMNS`]), in the order of its table.
+pub(crate) fn channel_names() -> Vec<&'static str> {
+    columns::names(&COLUMNS)
+}
+
+/// The `sweep` block of the document: the swept quantity and its values, each channel of
+/// [`COLUMNS`] (`z_c` the feedback's with a setpoint; `modulus_dmt` the frame's modulus scale ×
+/// the fitted Hertz group) over them (`null` where a point failed) and their units, the orbit's
+/// period and stability, and each point's message (`null` when computed).
+pub(crate) fn sweep_document(sweep: &PeakForceSweep, frame: &Frame, taps: &[SweepTap]) -> Value {
+    let si = frame.u.si;
     json!({
         "quantity": sweep.quantity.name(),
-        "unit": sweep.quantity.unit(u.si),
+        "unit": sweep.quantity.unit(si),
         "values": sweep.values,
-        "channels": channels,
-        "units": units,
+        "channels": columns::arrays(&COLUMNS, frame, taps),
+        "units": columns::units(&COLUMNS, &UnitNames::si_or_model(si)),
         "period": taps.iter().map(|t| t.tap.as_ref().map(|t| t.period)).collect::<Vec<_>>(),
         "stable": taps.iter().map(|t| t.tap.as_ref().map(|t| t.stable)).collect::<Vec<_>>(),
         "transient_periods": taps.iter().map(|t| t.tap.as_ref().map(|t| t.transient_periods)).collect::<Vec<_>>(),
@@ -326,57 +275,34 @@ pub(crate) fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
         .collect()
 }
 
-/// The sweep's layout from the document's `sweep` block: the values as the coordinate of the
-/// dimension named after the swept quantity, every channel over it (NaN where a point
-/// failed), and `period` (0 where a point failed).
-pub(crate) fn sweep_layout(block: &Value) -> Layout {
-    let dim = block["quantity"].as_str().unwrap_or("value").to_string();
-    let nums = |v: &Value| -> Vec<f64> {
-        v.as_array().map_or(Vec::new(), |a| {
-            a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()
-        })
-    };
-    let values = nums(&block["values"]);
-    let n = values.len();
-    let d = [dim.as_str()];
-    let mut variables = vec![Variable::f64(
-        &dim,
-        &d,
-        block["unit"].as_str().unwrap_or(""),
-        format!("swept {dim}"),
-        &values,
-    )];
-    let units = &block["units"];
-    let mut names: Vec<&str> = CHANNELS.iter().map(|c| c.0).collect();
-    names.push("modulus_dmt");
-    for name in names {
-        // the swept z_c is the coordinate itself
-        if name == dim {
-            continue;
-        }
-        let long = CHANNELS
-            .iter()
-            .find(|c| c.0 == name)
-            .map_or("fitted DMT modulus of the retract (PF-QNM)", |c| c.2);
-        variables.push(Variable::f64(
-            name,
-            &d,
-            units[name].as_str().unwrap_or(""),
-            long,
-            &nums(&block["channels"][name]),
-        ));
-    }
-    let period: Vec<f64> = block["period"].as_array().map_or(Vec::new(), |a| {
-        a.iter().map(|x| x.as_f64().unwrap_or(0.0)).collect()
-    });
+/// The sweep's layout: the values as the coordinate of the dimension named after the swept
+/// quantity, every channel of [`COLUMNS`] over it but the swept one (NaN where a point failed;
+/// `modulus_dmt` last), and `period` (0 where a point failed).
+pub(crate) fn sweep_layout(sweep: &PeakForceSweep, frame: &Frame, taps: &[SweepTap]) -> Layout {
+    let (dim, si) = (sweep.quantity.name(), frame.u.si);
+    let d = [dim];
+    let unit = sweep.quantity.unit(si);
+    let swept = format!("swept {dim}");
+    let mut variables = vec![Variable::f64(dim, &d, unit, swept, &sweep.values)];
+    let names = UnitNames::si_or_model(si);
+    let mut channels = columns::variables(&COLUMNS, frame, taps, &d, &names);
+    // the swept z_c is the coordinate itself
+    channels.retain(|v| v.name != dim);
+    // the layout lists the modulus last (the table after ringing_amplitude)
+    let modulus = channels.iter().position(|v| v.name == "modulus_dmt");
+    let modulus = channels.remove(modulus.expect("a column"));
+    variables.extend(channels.into_iter().chain([modulus]));
+    let period = taps
+        .iter()
+        .map(|t| t.tap.as_ref().map_or(0.0, |t| t.period as f64));
     variables.push(Variable::new(
         "period",
         &d,
         "modulation periods",
         "period of the orbit (0: the point failed)",
-        Values::F64(period),
+        Values::F64(period.collect()),
     ));
-    Layout::new("peakforce sweep", &[(dim.as_str(), n)], variables)
+    Layout::new("peakforce sweep", &[(dim, sweep.values.len())], variables)
 }
 
 /// One value of a PeakForce sweep: its place, the model it was computed on (α5 is the tap's:

@@ -7,18 +7,23 @@ use crate::report::{OutputsNote, Presentation, TextUnits};
 use serde_json::Value;
 use std::path::Path;
 
-/// The presentation of an FM curve's `document` ([`crate::request::fm::document`]): the
-/// summary (Δf at both ends, the largest excitation, unstable points and folds), and with
-/// `files` the table `fm.csv`, the figure (all files) and the document `fm.json`; when the
-/// files go to `dir`, the document records the table's path there (`"csv"`, in the document
-/// printed too).
-pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path>) -> Presentation {
+/// The presentation of an FM curve's `document` ([`crate::request::fm::document`]) and its
+/// table (column names and rows, [`crate::request::fm::table`]): the summary (Δf at both ends,
+/// the largest excitation, unstable points and folds), and with `files` the table `fm.csv`,
+/// the figure (all files) and the document `fm.json`; when the files go to `dir`, the document
+/// records the table's path there (`"csv"`, in the document printed too).
+pub fn fm(
+    document: &mut Value,
+    (columns, table): (Vec<&str>, Vec<Vec<f64>>),
+    text: TextUnits,
+    files: Files,
+    dir: Option<&Path>,
+) -> Presentation {
     let mut p = Presentation {
         outputs_note: OutputsNote::Tail,
         ..Presentation::default()
     };
-    let table = rows(document);
-    let k = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
+    let k = |name: &str| columns.iter().position(|c| *c == name).unwrap_or(0);
     let si = text.si();
     let value = |v: f64, si_unit: &str, model_unit: &str| {
         if si {
@@ -54,7 +59,7 @@ pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path
             .iter()
             .map(|r| r.iter().map(|v| f(*v)).collect())
             .collect();
-        p.csv("fm.csv", &COLUMNS, text);
+        p.csv("fm.csv", &columns, text);
     }
     if files == Files::All {
         let (x_unit, y_unit) = if si {
@@ -78,56 +83,4 @@ pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path
     }
     with_document(&mut p, document, ("fm.json", "fm.csv"), dir);
     p
-}
-
-/// The columns of an FM curve's table (`fm.csv`, Python's Dataset variables), in order: the
-/// numeric arrays of the document's `curve` (`stable` as 1/0).
-pub const COLUMNS: [&str; 18] = [
-    "z_c",
-    "frequency_shift",
-    "frequency",
-    "excitation",
-    "amplitude",
-    "phase_deg",
-    "energy_dissipated",
-    "virial",
-    "mean_deflection",
-    "min_distance",
-    "peak_force",
-    "mean_force",
-    "law_force",
-    "indentation",
-    "max_multiplier",
-    "stable",
-    "loop_residual",
-    "iterations",
-];
-
-/// The rows of the table of an FM document ([`crate::request::fm::document`]), one per point, in [`COLUMNS`]
-/// order.
-pub fn rows(doc: &Value) -> Vec<Vec<f64>> {
-    let curve = &doc["curve"];
-    let column = |name: &str| -> Vec<f64> {
-        curve[name]
-            .as_array()
-            .map(|a| {
-                a.iter()
-                    .map(|v| match v {
-                        Value::Bool(b) => f64::from(u8::from(*b)),
-                        v => v.as_f64().unwrap_or(f64::NAN),
-                    })
-                    .collect()
-            })
-            .unwrap_or_default()
-    };
-    let columns: Vec<Vec<f64>> = COLUMNS.iter().map(|c| column(c)).collect();
-    let n = columns[0].len();
-    (0..n)
-        .map(|i| {
-            columns
-                .iter()
-                .map(|c| c.get(i).copied().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect()
 }

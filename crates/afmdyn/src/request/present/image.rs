@@ -3,6 +3,7 @@
 //! the setpoint study's plots and the text summary, for the ideal feedback and the PI scan.
 
 use crate::error::number;
+use crate::layout::columns::UnitNames;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::{Presentation, TextUnits};
 use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
@@ -377,7 +378,7 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
 /// ([`crate::request::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
 /// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point,
 /// as [`PeakForceImage::document_head`], and its pixels: `pixels`, `taps` the steady taps of
-/// the continuations into them, `reengaged`, and `maps`, each of [`PF_FIELDS`] summarised
+/// the continuations into them, `reengaged`, and `maps`, each of `PF_FIELDS` summarised
 /// over them as [`number_summary`]), `taps`, `warnings`. [`PeakForceImage::document`] is the
 /// document with every pixel.
 pub fn peakforce_summary(img: &PeakForceImage) -> Value {
@@ -399,9 +400,10 @@ pub fn peakforce_summary(img: &PeakForceImage) -> Value {
             .collect();
         let pixels = || mine.iter().map(|&(j, i)| &img.pixels[j][i]);
         let mut maps = serde_json::Map::new();
-        for (name, units, _) in PF_FIELDS {
-            let values = mine.iter().map(|&(j, i)| img.value(name, j, i));
-            maps.insert(name.into(), number_summary(units, values));
+        for c in &PF_FIELDS {
+            let values = mine.iter().map(|cell| c.number(img, cell));
+            let units = c.unit.name(&UnitNames::si_or_model(true));
+            maps.insert(c.name.into(), number_summary(units, values));
         }
         entry["pixels"] = json!(mine.len());
         entry["taps"] = json!(pixels().map(|p| p.evaluations).sum::<usize>());

@@ -46,26 +46,11 @@ pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// The channels of a sweep's table (`peakforce-sweep.csv`), after the swept value (`z_c` or
-/// `modulation_frequency`; a swept z_c is not repeated).
-pub const SWEEP_COLUMNS: [&str; 10] = [
-    "peak_force",
-    "adhesion",
-    "deformation",
-    "dissipation",
-    "contact_time",
-    "snap_off_time",
-    "ringing_amplitude",
-    "modulus_dmt",
-    "taps_per_cycle",
-    "z_c",
-];
-
 /// A sweep's table: the swept quantity's name, the rows, the column names.
 type SweepTable = (String, Vec<Vec<f64>>, Vec<&'static str>);
 
 /// A sweep's table from the document's `sweep` block: (the swept quantity's name, the rows —
-/// the value, then the [`SWEEP_COLUMNS`] but the swept one, NaN where a point failed —, the
+/// the value, then the sweep's channels but the swept one, NaN where a point failed —, the
 /// column names); `None` without a sweep.
 fn sweep_table(doc: &Value) -> Option<SweepTable> {
     let block = doc.get("sweep").filter(|b| !b.is_null())?;
@@ -77,7 +62,8 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
     } else {
         "modulation_frequency"
     }];
-    columns.extend(SWEEP_COLUMNS.iter().filter(|c| **c != param));
+    let channels = crate::request::peakforce_sweep::channel_names();
+    columns.extend(channels.into_iter().filter(|c| *c != param));
     let channels = rows(block, "channels", &columns[1..]);
     let table = values
         .iter()
@@ -309,7 +295,7 @@ fn figures(
     );
     if let Some((param, rows, _)) = sweep {
         let unit = document["sweep"]["unit"].as_str().unwrap_or("");
-        // columns: the value, then SWEEP_COLUMNS (peak_force, adhesion first)
+        // columns: the value, then the sweep's channels (peak_force, adhesion first)
         let peak = rows.iter().map(|r| (r[0], r[1])).collect();
         let adhesion = rows.iter().map(|r| (r[0], r[2])).collect();
         p.figure(
