@@ -328,7 +328,6 @@ pub use capillary::{
 pub use dmt::PreparedDmt;
 pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VACUUM_PERMITTIVITY};
-pub use impact::IMPACT_DEFAULT_RESTITUTION;
 pub use jkr::{Jkr, PreparedJkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
 pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
 pub use prepared::{AsGiven, PreparedForce, PreparedLaw};
@@ -379,7 +378,7 @@ impl ContactLaw {
     }
 
     /// The law's descriptor in [`LAWS`].
-    pub fn info(&self) -> &'static LawInfo {
+    pub(crate) fn info(&self) -> &'static LawInfo {
         self.kind().info()
     }
 
@@ -473,7 +472,7 @@ impl LawKind {
     };
 
     /// The kind's descriptor in [`LAWS`].
-    pub fn info(self) -> &'static LawInfo {
+    pub(crate) fn info(self) -> &'static LawInfo {
         let i = LawKind::ALL
             .iter()
             .position(|&k| k == self)
@@ -570,7 +569,7 @@ pub struct LawGroups([Option<f64>; GROUPS.len()]);
 
 impl LawGroups {
     /// The groups of `law` (those it has), e.g. to keep them when another group is changed.
-    pub fn of(law: ContactLaw) -> LawGroups {
+    pub(crate) fn of(law: ContactLaw) -> LawGroups {
         law.groups()
     }
 
@@ -603,12 +602,12 @@ impl LawGroups {
     }
 
     /// Each group by its name ([`Param::name`]), given or not, in the order of [`GROUPS`].
-    pub fn entries(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
+    pub(crate) fn entries(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
         GROUPS.iter().zip(self.0).map(|(p, v)| (p.name, v))
     }
 
     /// The groups given, by name, in the order of [`GROUPS`].
-    pub fn given(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+    pub(crate) fn given(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
         self.entries().filter_map(|(name, v)| Some((name, v?)))
     }
 

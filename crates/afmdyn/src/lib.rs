@@ -76,7 +76,7 @@ pub mod params;
 pub mod probe;
 pub mod report;
 pub mod request;
-pub mod roots;
+pub(crate) mod roots;
 pub mod study;
 pub mod system;
 pub mod tip_sample;

@@ -75,7 +75,7 @@ pub struct PreparedDmt<L> {
 
 impl<L: Law> PreparedDmt<L> {
     /// `law` (with ã₀ its [`Law::distance_offset`]) with α4 = `k`, α6 = `c`.
-    pub fn new(law: L, k: f64, c: f64) -> Self {
+    pub(crate) fn new(law: L, k: f64, c: f64) -> Self {
         let a0 = law.distance_offset();
         PreparedDmt {
             law,

@@ -69,7 +69,7 @@ pub struct PreparedLaw {
 
 impl PreparedLaw {
     /// Prepare `ts`'s law with its α4 and α6.
-    pub fn new(ts: TipSample) -> PreparedLaw {
+    pub(crate) fn new(ts: TipSample) -> PreparedLaw {
         PreparedLaw {
             ts,
             prepared: ts.law.prepare(ts.stiffness, ts.damping),

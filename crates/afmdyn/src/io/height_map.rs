@@ -4,7 +4,7 @@
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
 //!   lines skipped). A file larger than [`MAX_CSV_BYTES`], or with a line longer than
-//!   [`super::input::MAX_CSV_LINE_BYTES`] (`/dev/zero`), is refused, and no more is read.
+//!   `super::input::MAX_CSV_LINE_BYTES` (`/dev/zero`), is refused, and no more is read.
 //! - **NPY** (`.npy`, NumPy's `np.save`): a 2-D float64 array (`<f8` or `>f8`, C or Fortran
 //!   order), `[row][column]` as the CSV (the `npyz` crate). The file is at most
 //!   [`MAX_NPY_BYTES`], its header at most [`MAX_NPY_HEADER_BYTES`], and the dtype and shape

@@ -7,7 +7,7 @@ use super::*;
 /// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
 /// fraction, min distance, E_dis, virial, THD, the higher modes' participation
 /// √(Σ_{k≥2} A_k²)/A_1 from [`Observables::mode_amplitudes`].
-pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
+pub(crate) fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
     [
         o.amplitude * u.length,
         o.amplitude / o.closed_form.free_amplitude,
@@ -45,7 +45,7 @@ pub fn higher_mode_fraction(amplitudes: &[f64]) -> f64 {
 /// `mode_balance`);
 /// [`crate::analysis::observables::ComponentObservables`]). The `"reported"` block of
 /// `observe`'s document, which Python's dataset is built from.
-pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
+pub(crate) fn observed(o: &Observables, u: &CurveUnits) -> Value {
     let mut m = serde_json::Map::new();
     for (c, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
         m.insert(c.name.into(), json!(v));
@@ -374,7 +374,7 @@ pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Par
 
 /// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
 /// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
-/// [`Params::rest_distance`]) and the [`CURVE_COLUMNS`], plus `stable`, `period` (null when not
+/// [`Params::rest_distance`]) and the `CURVE_COLUMNS`, plus `stable`, `period` (null when not
 /// period-n) and `reached` ([`crate::analysis::stepped::Reached`]); each branch the same
 /// columns with `stable`, `period` and `event` (null, "fold", "grazing", …). Also `folds` and
 /// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
@@ -394,7 +394,7 @@ fn z_c_of<'a>(params: &'a Params, u: &'a CurveUnits) -> impl Fn(f64) -> f64 + 'a
 /// The regime of a steady state from its mean deflection ⟨W⟩ (any length unit):
 /// `"attractive"` where the mean tip–sample force, k⟨W⟩ for the point mass, is negative, else
 /// `"repulsive"` (García & San Paulo, *Phys. Rev. B* 61 (2000) R13381).
-pub fn regime(mean_deflection: f64) -> &'static str {
+pub(crate) fn regime(mean_deflection: f64) -> &'static str {
     if mean_deflection < 0.0 {
         "attractive"
     } else {
@@ -407,7 +407,7 @@ pub fn regime(mean_deflection: f64) -> &'static str {
 /// (`points`, [`crate::analysis::setpoint::operating_points`]) its `source` (`"branch k"`,
 /// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
 /// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
-/// [`CURVE_COLUMNS`] of its orbit (interpolated between two time-averaged motions).
+/// `CURVE_COLUMNS` of its orbit (interpolated between two time-averaged motions).
 pub fn setpoint(
     params: &Params,
     c: &SteppedCurve,

@@ -57,11 +57,11 @@ pub struct SimulateSummary {
 
 /// Relative per-period energy residual above which a run is reported as inaccurate (normal runs
 /// close to ~1e-10 with the exact propagator and with the adaptive integrator's dense output).
-pub const ENERGY_TOLERANCE: f64 = 1e-6;
+pub(crate) const ENERGY_TOLERANCE: f64 = 1e-6;
 
 /// The run's own accuracy checks that failed: the energy balance beyond [`ENERGY_TOLERANCE`],
 /// and the beam body reaching the substrate (outside the paper's model, Fig. 2f).
-pub fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
+pub(crate) fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
     let mut w = vec![];
     let relative = s.energy_residual.1;
     if relative.is_nan() || relative > ENERGY_TOLERANCE {
@@ -83,7 +83,7 @@ pub fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
 
 /// `afmdyn simulate --json`: final time and state, events, body contact, section points, the
 /// energy-balance residual and [`simulate_warnings`].
-pub fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
+pub(crate) fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
     let zf = &s.final_state;
     let n = model.modes();
     json!({
@@ -104,7 +104,7 @@ pub fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
     })
 }
 
-/// [`simulate_summary`] of a whole [`Trajectory`].
+/// `simulate_summary` of a whole [`Trajectory`].
 pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
     simulate_summary(
         model,
@@ -145,7 +145,7 @@ pub fn initial_modal(z: Option<&DVector<f64>>) -> String {
 
 /// One attractor of `afmdyn attractors --json`; `multipliers` ([re, im] pairs) and `stable` of
 /// the shooting-polished orbit, null for a nonperiodic motion.
-pub fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> Value {
+pub(crate) fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> Value {
     json!({
         "multipliers": orbit.map(|o| o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
         "stable": orbit.map(|o| o.stable),
@@ -388,7 +388,7 @@ mod curves;
 mod present;
 mod series;
 mod units;
-pub use branches::*;
+pub(crate) use branches::*;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
 pub use curves::*;

@@ -55,7 +55,7 @@ pub fn intervals_method(o: &FitOutcome) -> &'static str {
 pub const MIN_FIT_ROWS: usize = 8;
 
 /// The physical range [lo, hi] of a fitted quantity from the probe's ranges
-/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
+/// (`crate::probe::ranges::SI_RANGES`; a positive quantity without a lower bound there is
 /// bounded by 0); (−∞, ∞) for the contact point and the baseline.
 pub fn bounds(name: &str) -> (f64, f64) {
     let (section, key) = match name.split_once('.') {

@@ -88,7 +88,7 @@ pub const FM_DEFAULT_DECAY: f64 = super::reconstruct::DECAYED / 2.0;
 /// `to` (by bisection to round-off), from Giessibl's first-order shift, which is
 /// proportional to the cosine-weighted mean force over a cycle,
 /// Δf ∝ −⟨F(z_c + A cos θ) cos θ⟩_θ (Giessibl, *Phys. Rev. B* 56, 16010 (1997), eq. 11;
-/// [`crate::analysis::fm::law_force`] the law's conservative force at distance d, the mean by
+/// `crate::analysis::fm::law_force` the law's conservative force at distance d, the mean by
 /// the midpoint rule over enough phases to resolve the closest approach, 40 across its
 /// width √(2 d_min/A)). `None` when the law has no force before contact (the
 /// shift at `to` is 0) or it does not decay within 10⁶ g₀.
@@ -139,7 +139,7 @@ pub fn default_from(base: &crate::Params, a: f64, to: f64) -> Option<f64> {
 
 impl FmRequest {
     /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
-    pub fn units(model: &Resolved) -> CurveUnits {
+    pub(crate) fn units(model: &Resolved) -> CurveUnits {
         match &model.probe {
             Some(p) => CurveUnits::from_scales(&p.scales, true),
             None => CurveUnits::dimensionless(),

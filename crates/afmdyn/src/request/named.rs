@@ -8,7 +8,7 @@
 //!
 //! The names are those of [`NAMES`]; `simulate` records its trajectory whole in memory
 //! (its own budgets, [`SimulateRequest::validate_in_memory`]) and `bimodal` is the approach
-//! curve of a multifrequency drive ([`super::curves::check_bimodal`]).
+//! curve of a multifrequency drive (`super::curves::check_bimodal`).
 
 use super::reconstruct_document::FromDocument;
 use super::run::{document, run, Analysis, Resolved};

@@ -7,7 +7,7 @@
 //! `cantilevers`) call theirs directly.
 
 #[cfg(feature = "files")]
-pub mod census;
+pub(crate) mod census;
 #[cfg(feature = "files")]
 pub(crate) mod continuation;
 #[cfg(feature = "files")]
@@ -22,7 +22,7 @@ pub mod modes;
 pub(crate) mod orbits;
 pub mod peakforce;
 pub mod reconstruct;
-pub mod sweeps;
+pub(crate) mod sweeps;
 
 /// Which files a presentation holds (`--files`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

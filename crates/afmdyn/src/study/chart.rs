@@ -1,6 +1,6 @@
 //! A behaviour chart ([`crate::request::chart::Chart`]) as a [`Study`]: its tasks are the
 //! tiles of [`ChartPlan`] (cells of one row, continued along x), its record a tile's cells
-//! with the task's number, what a resume skips the stored tasks ([`super::chart_store`]).
+//! with the task's number, what a resume skips the stored tasks (`super::chart_store`).
 
 use super::{execute_in_memory, Study};
 use crate::analysis::chart::run_chart;
@@ -102,7 +102,7 @@ impl Analysis for Chart {
 
 /// The cells of the tasks `records` (a [`super::MemoryStore`]'s, in any order), row
 /// by row, x increasing.
-pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
+pub(crate) fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
     let mut cells: Vec<ChartCell> = records.into_iter().flat_map(|(_, c)| c).collect();
     cells.sort_by_key(|c| (c.iy, c.ix));
     cells

@@ -1,7 +1,7 @@
-//! The resumable store of a chart (feature `files`): a [`TaskStore`] of tiles in the directory
+//! The resumable store of a chart (feature `files`): a `TaskStore` of tiles in the directory
 //! `afmdyn chart --out DIR` names — `.chart.run.json` (the ledger) and `.chart.tiles.jsonl`
 //! (one checksummed line per finished tile, its cells under `"cells"`), as
-//! [`super::task_store`] describes.
+//! `super::task_store` describes.
 
 use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;

@@ -8,17 +8,17 @@
 //! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
 //!   appends a finished task, and finishes atomically (the files in the one order); the file
 //!   stores lock their directory for one run at a time
-//!   ([`crate::request::checkpoint_file::FileCheckpoint`] for sweeps; `task_store::TaskStore`,
+//!   (`crate::request::checkpoint_file::FileCheckpoint` for sweeps; `task_store::TaskStore`,
 //!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `chart_store`; a PI-scanned image's lines, `scan_store`); [`MemoryStore`] keeps the tasks
+//!   `chart_store`; a PI-scanned image's lines, `scan_store`); `MemoryStore` keeps the tasks
 //!   in memory.
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
-//!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
+//!   `crate::request::limits::check_threads`), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
 //! - [`plan`] (feature `files`): the studies as stages of tasks for an executor outside the
 //!   library (Dask), each rebuilt from its recipe, with its ledger.
-//! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
+//! - the studies: [`chart`] (a behaviour chart's tiles, its store `chart_store`), [`sweep`]
 //!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
 //!   (a basin map's rows, pass by pass, its store `basins::basin_store`),
 //!   [`global_continuation`] (a global continuation's values, one chain, its store
@@ -48,15 +48,15 @@ pub mod peakforce_image;
 pub mod plan;
 pub mod scan;
 #[cfg(feature = "files")]
-pub mod scan_store;
+pub(crate) mod scan_store;
 pub mod stepped;
 #[cfg(feature = "files")]
 pub mod stored;
 pub mod sweep;
 #[cfg(feature = "files")]
-pub mod task_store;
+pub(crate) mod task_store;
 
-pub use memory::MemoryStore;
+pub(crate) use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -259,7 +259,7 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
 /// # Errors
 /// [`SimError::Cancelled`] when the observer's flag stopped the run; the pool's errors and the
 /// study's ([`Study::run`]).
-pub fn execute_in_memory<S: Study + ?Sized>(
+pub(crate) fn execute_in_memory<S: Study + ?Sized>(
     study: &S,
     threads: Option<usize>,
     observer: &dyn Observer,

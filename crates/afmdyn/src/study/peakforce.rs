@@ -1,4 +1,4 @@
-//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a [`Study`] ([`PeakForceStudy`]): a
+//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a [`Study`] (`PeakForceStudy`): a
 //! task is one value of the swept quantity (the mean rest separation z_c, or the modulation
 //! frequency), numbered by its place in the values; its record the steady tap there, or why it
 //! failed. The tasks form one chain: each tap's transient starts from the previous tap's orbit
@@ -9,7 +9,7 @@
 //! feedback) each value runs the feedback's own search
 //! ([`crate::analysis::peakforce::peak_force_setpoint`], from rest).
 //!
-//! Run in memory ([`super::execute_in_memory`]) by the `peakforce` request with a sweep, whose
+//! Run in memory (`super::execute_in_memory`) by the `peakforce` request with a sweep, whose
 //! [`Analysis`] (running a request: a study's layer, above the request's data) is here.
 
 use super::{Prefix, Study};
@@ -32,7 +32,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A PeakForce sweep as a [`Study`] (see the module doc).
 #[derive(Debug, Clone)]
-pub struct PeakForceStudy {
+pub(crate) struct PeakForceStudy {
     /// The model of every value, in the order of the sweep.
     pub points: Vec<Params>,
     /// The peak force the ideal feedback holds at every value (F̃), or `None` (the points' own
@@ -49,7 +49,7 @@ impl PeakForceStudy {
     ///
     /// # Errors
     /// [`SimError::Cancelled`] when a value is missing (a run cut short).
-    pub fn taps(&self, mut records: Vec<SweepTap>) -> Result<Vec<SweepTap>, SimError> {
+    pub(crate) fn taps(&self, mut records: Vec<SweepTap>) -> Result<Vec<SweepTap>, SimError> {
         records.sort_by_key(|r| r.index);
         if records.len() != self.points.len()
             || records.iter().enumerate().any(|(i, r)| r.index != i)

@@ -52,7 +52,7 @@ impl Study for ScanStudy {
 /// `threads` worker threads (`None`: all cores) with progress and cancellation in `observer`.
 ///
 /// # Errors
-/// As [`ScanStudy::new`] and the lines; [`SimError::Cancelled`].
+/// As `ScanStudy::new` and the lines; [`SimError::Cancelled`].
 pub fn pi_image(
     probe_table: &toml::Table,
     map: &SampleMap,

@@ -46,7 +46,7 @@ const CRC_KEY: &str = ",\"crc32\":\"";
 
 /// The files and keys of one kind of study's store.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TaskFiles {
+pub(crate) struct TaskFiles {
     /// The ledger's file name.
     pub ledger: &'static str,
     /// The records' file name.
@@ -62,7 +62,7 @@ pub struct TaskFiles {
 
 /// How a store's line holds its record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Encoding {
+pub(crate) enum Encoding {
     /// JSON (readable; for records whose floats are all finite: JSON has no NaN or ±∞).
     Json,
     /// A string: the record's CBOR encoding (RFC 8949, by `ciborium`) in standard base64 —
@@ -98,7 +98,7 @@ pub struct TaskStore<'a, R> {
 
 impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// The store of the directory `lock` holds, in `files`.
-    pub fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
+    pub(crate) fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
         TaskStore {
             files,
             lock,
@@ -113,7 +113,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// hands them back without reading and decoding the file again — for a study whose
     /// records a resume reads anyway (a chain's: [`StoredTasks`] for `Vec<R>`), not for one
     /// whose records must stay on disk.
-    pub fn keeping(mut self) -> TaskStore<'a, R> {
+    pub(crate) fn keeping(mut self) -> TaskStore<'a, R> {
         self.kept = Some((BTreeMap::new(), false));
         self
     }
@@ -382,7 +382,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
 ///
 /// # Errors
 /// The encoder's message.
-pub fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> {
+pub(crate) fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> {
     let mut bytes = Vec::new();
     ciborium::into_writer(value, &mut bytes).map_err(|e| e.to_string())?;
     Ok(BASE64.encode(bytes))
@@ -401,7 +401,7 @@ pub(crate) fn from_cbor_text<T: DeserializeOwned>(text: &str) -> Result<T, Strin
 /// (`HashSet<usize>`: their records stay in the file, memory does not grow with the study) or
 /// the records themselves in the order of the tasks (`Vec<R>`: a study whose later tasks start
 /// from the earlier ones' results, as a basin map's passes do).
-pub trait StoredTasks<R>: Sized {
+pub(crate) trait StoredTasks<R>: Sized {
     /// Read from `store`, just opened, whose stored tasks are `tasks`.
     ///
     /// # Errors

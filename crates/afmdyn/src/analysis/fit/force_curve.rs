@@ -41,7 +41,7 @@ use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law, LawKin
 /// solid (Zener, with surface memory, in time: its model is
 /// [`super::sls_curve::SlsCurveModel`], not [`ForceCurveModel`]); `None` for a law the fit does
 /// not take.
-pub fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
+pub(crate) fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
     match law {
         LawKind::Hertz => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE]),
         LawKind::Dmt => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER]),
@@ -60,7 +60,7 @@ pub fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
 /// `sample.youngs_modulus` (Pa).
 pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `tip.radius` (m).
-pub const RADIUS: &str = "tip.radius";
+pub(crate) const RADIUS: &str = "tip.radius";
 /// `contact_point` (m): the tip position where δ = 0, after `correct_tip_offset`.
 pub(crate) const CONTACT_POINT: &str = "contact_point";
 /// `baseline` (N): the force far from the sample, after `correct_force_offset`.
@@ -176,10 +176,10 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
 }
 
 /// The force-curve model at the rows' tip positions (module docs). Parameters in
-/// [`parameter_names`]' order.
+/// `parameter_names`' order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceCurveModel {
-    /// The law (one [`parameter_names`] takes).
+    /// The law (one `parameter_names` takes).
     pub law: LawKind,
     /// The tip positions x (m) of the fitted rows.
     pub x: Vec<f64>,

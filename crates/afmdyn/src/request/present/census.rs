@@ -194,7 +194,7 @@ fn summary(
 }
 
 /// The warning of failed random starts of a census of `samples`, if any.
-pub fn failed_starts(report: &AttractorReport, samples: usize) -> Option<String> {
+pub(crate) fn failed_starts(report: &AttractorReport, samples: usize) -> Option<String> {
     report.failures.first().map(|first| {
         format!(
             "{} of {samples} random starts failed; the first: {first}",

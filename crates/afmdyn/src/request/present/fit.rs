@@ -11,7 +11,7 @@ use serde_json::Value;
 use std::path::Path;
 
 /// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
-pub const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
+pub(crate) const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
 
 /// The summary line of the estimate `e` of `name` in `unit`: value ± standard error and the
 /// 95 % interval, the error's two digits setting the decimals of every number where it has

@@ -13,7 +13,7 @@ use std::path::Path;
 pub(crate) const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
 /// The columns of the force–distance curve's table (`peakforce-curve.csv`): approach and
 /// retract side by side (the retract has as many points as the approach, or one more).
-pub const CURVE_COLUMNS: [&str; 4] = [
+pub(crate) const CURVE_COLUMNS: [&str; 4] = [
     "approach_distance",
     "approach_force",
     "retract_distance",
@@ -48,7 +48,7 @@ pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
 
 /// The channels of a sweep's table (`peakforce-sweep.csv`), after the swept value (`z_c` or
 /// `modulation_frequency`; a swept z_c is not repeated).
-pub const SWEEP_COLUMNS: [&str; 10] = [
+pub(crate) const SWEEP_COLUMNS: [&str; 10] = [
     "peak_force",
     "adhesion",
     "deformation",
