@@ -46,7 +46,7 @@ const LIBRARY: &str = include_str!("../assets/cantilevers.toml");
 /// # Panics
 /// Never for the embedded file (its reading is tested); a malformed entry would panic at the
 /// first call.
-pub fn cantilevers() -> &'static [Cantilever] {
+pub(crate) fn cantilevers() -> &'static [Cantilever] {
     static ALL: OnceLock<Vec<Cantilever>> = OnceLock::new();
     ALL.get_or_init(|| {
         let root: toml::Table = LIBRARY.parse().expect("the embedded cantilever library");

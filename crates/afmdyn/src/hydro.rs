@@ -248,10 +248,10 @@ impl Section {
 
     /// The mode of this section resonating at `frequency_hz` in `medium`: its quality factor
     /// Q = (1/T + Γ_r)/Γ_i and added mass TΓ_r at that frequency, and the vacuum frequency
-    /// f_vac = f √(1 + TΓ_r) it comes from (the inverse of [`wet_mode_of`], closed form).
+    /// f_vac = f √(1 + TΓ_r) it comes from (the inverse of `wet_mode_of`, closed form).
     ///
     /// # Errors
-    /// As [`wet_mode_of`].
+    /// As `wet_mode_of`.
     pub fn mode_at(&self, frequency_hz: f64, medium: &Medium) -> Result<(WetMode, f64), SimError> {
         self.validate()?;
         medium.validate()?;
@@ -273,7 +273,7 @@ impl Section {
 
 /// The mode of vacuum frequency `vacuum_frequency_hz` of the rectangular beam `beam` (its
 /// width, thickness and density) in `medium`: the wet frequency, quality factor and added mass
-/// (module docs). [`wet_mode_of`] of its [`Section`].
+/// (module docs). `wet_mode_of` of its [`Section`].
 ///
 /// # Errors
 /// [`SimError::Units`] naming the field for an invalid beam, medium or frequency;
@@ -293,7 +293,7 @@ pub fn wet_mode(
 /// # Errors
 /// [`SimError::Units`] naming the field for an invalid section, medium or frequency;
 /// [`SimError::OutOfRange`] naming `reynolds` when the wet mode's Re leaves Sader's range.
-pub fn wet_mode_of(
+pub(crate) fn wet_mode_of(
     vacuum_frequency_hz: f64,
     section: &Section,
     medium: &Medium,

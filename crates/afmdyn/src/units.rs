@@ -99,7 +99,7 @@ pub(crate) fn preset<T: Copy>(
 }
 
 /// Hertz contact stiffness K₁ = 2E*√(RΔ) (paper §4), E* of tip and sample
-/// ([`crate::contact::reduced_modulus`]). N/m.
+/// (`crate::contact::reduced_modulus`). N/m.
 pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
     let (t, s) = (tip, sample);
     let e_star = crate::contact::reduced_modulus(

@@ -28,7 +28,7 @@
 //! snap-off time (the last exit from contact in the cycle, from t = 0), the ringing amplitude
 //! (after snap-off, the largest |W − c F_c| with c = φ(1)ᵀK⁻¹φ(1) the lever's static
 //! compliance at the tip: the deviation from the quasi-static deflection) and the DMT fit of
-//! the retract curve ([`fit_dmt`]) on the force the instrument measures, W/c (k × deflection),
+//! the retract curve (`fit_dmt`) on the force the instrument measures, W/c (k × deflection),
 //! against the distance d (the instrument's separation, z-piezo plus deflection), and the
 //! same fit on the true force F_c: the channels are the true tip–sample force's, the fit
 //! shows the instrument method's bias.
@@ -39,7 +39,7 @@ mod setpoint;
 
 pub use filter::low_pass_periodic;
 pub(crate) use fit::MIN_FIT_POINTS;
-pub use fit::{fit_dmt, DmtFit, FIT_BAND};
+pub(crate) use fit::{fit_dmt, DmtFit, FIT_BAND};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,
     SETPOINT_TOL,
@@ -72,7 +72,7 @@ pub struct PeakForceOptions {
     /// Samples of the reported cycle, in `MIN_CYCLE_SAMPLES`..=`MAX_CYCLE_SAMPLES`.
     pub samples: usize,
     /// The force fractions (lo, hi) of the retract curve's range [adhesion, peak] the DMT fit
-    /// uses ([`FIT_BAND`], 0 ≤ lo < hi ≤ 1).
+    /// uses (`FIT_BAND`, 0 ≤ lo < hi ≤ 1).
     pub fit_band: (f64, f64),
     /// The transient's settling (the default: tolerance 1e-8, cap from the slowest decay).
     pub steady: SteadyOptions,

@@ -53,7 +53,7 @@
 //! Units: any consistent set (SI: d and A in m, Δf and f0 in Hz, k in N/m → F in N, U in J).
 
 use super::progress::Progress;
-pub use super::reconstruct::ExactRecord;
+pub(crate) use super::reconstruct::ExactRecord;
 use super::reconstruct::{sader_jarvis, uniform_spacing, Reconstruction, ShiftCurve};
 use super::reconstruct_am::{nodes_within, weight};
 use crate::error::SimError;

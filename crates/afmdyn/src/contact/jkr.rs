@@ -106,7 +106,7 @@ impl Law for JkrLaw {
     }
 }
 
-/// JKR's prepare step ([`Law::prepare`]): the contact's constants ([`Jkr::new`]: two square
+/// JKR's prepare step (`Law::prepare`): the contact's constants ([`Jkr::new`]: two square
 /// roots and a cube root of α4 and P̃) with the Kelvin–Voigt group α6. No force outside
 /// contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,7 +179,7 @@ impl Jkr {
 
     /// F_c(δ, δ̇) in contact with its partials, α6 = `c` the Kelvin–Voigt group (module docs):
     /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) (`Jkr::radius_variable`). The force of
-    /// [`JkrLaw`]'s [`Law::force`] in contact, from constants computed once
+    /// [`JkrLaw`]'s `Law::force` in contact, from constants computed once
     /// ([`PreparedJkr`]).
     pub fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
         let q = self.radius_variable(delta);

@@ -145,11 +145,11 @@ pub trait Law: Copy + Sized {
     const TIP_RADIUS: bool = false;
 
     /// The law's constants, derived once from its groups and α4, α6 ([`Law::prepare`]);
-    /// [`super::AsGiven`] for a law that derives nothing worth keeping.
+    /// `super::AsGiven` for a law that derives nothing worth keeping.
     type Prepared: PreparedForce + Copy + std::fmt::Debug + PartialEq;
 
     /// The prepare step: the law's groups with α4 = `k` and α6 = `c` turned into the constants
-    /// its force needs, once per model ([`super::PreparedLaw`]). Evaluating the result is
+    /// its force needs, once per model (`super::PreparedLaw`). Evaluating the result is
     /// [`Law::force`], [`Law::potential`] and [`Law::dissipative`] bit for bit (the same
     /// operations in the same order).
     fn prepare(&self, k: f64, c: f64) -> Self::Prepared;

@@ -11,7 +11,7 @@
 //!   are checked before the values are read.
 //!
 //! Both: at most [`MAX_PIXELS`] × [`MAX_PIXELS`] values, rows of one length, each finite and
-//! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
+//! within ±`MAX_HEIGHT` (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
 //! file and the problem (the row and column of a bad value).
 
 #[cfg(feature = "files")]
@@ -27,7 +27,7 @@ pub use super::caps::{MAX_CSV_BYTES, MAX_NPY_BYTES, MAX_NPY_HEADER_BYTES, MAX_PI
 
 /// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
 /// topography the z piezo follows.
-pub const MAX_HEIGHT: f64 = 1e-5;
+pub(crate) const MAX_HEIGHT: f64 = 1e-5;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.

@@ -49,7 +49,7 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
 ///
 /// # Errors
 /// What `write` returns; a [`FileError`] (converted) when the file cannot be renamed.
-pub fn atomic<F, E>(path: &Path, write: F) -> Result<(), E>
+pub(crate) fn atomic<F, E>(path: &Path, write: F) -> Result<(), E>
 where
     F: FnOnce(&Path) -> Result<(), E>,
     E: From<FileError>,
@@ -233,7 +233,7 @@ pub struct NpyStream {
 }
 
 /// The open file of an [`NpyStream`] and its buffer of encoded values.
-pub struct NpyFile {
+pub(crate) struct NpyFile {
     file: BufWriter<File>,
     buf: Vec<u8>,
 }

@@ -118,7 +118,7 @@
 mod medium;
 pub mod ranges;
 mod reader;
-pub use medium::{CalibratedIn, FluidMode, MediumReport};
+pub(crate) use medium::MediumReport;
 use reader::*;
 
 pub use crate::contact::VACUUM_PERMITTIVITY;

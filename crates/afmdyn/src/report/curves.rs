@@ -380,7 +380,7 @@ pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Par
 /// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
 /// `free_amplitude`, `units` (names), `scales` (the [`CurveUnits`] factors), `params` and
 /// `warnings`.
-pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let x = z_c_of(params, u);
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
 }
@@ -481,7 +481,7 @@ pub fn setpoint(
 
 /// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
 /// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
-pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+pub(crate) fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let scale = u.hz_per_omega.unwrap_or(1.0);
     let key = if u.hz_per_omega.is_some() {
         "frequency_hz"

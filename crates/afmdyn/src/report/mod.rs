@@ -35,7 +35,7 @@ pub fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -
     json!({ "params": params, "free": region_spectrum(free), "contact": region_spectrum(contact) })
 }
 
-pub use crate::trajectory::energy_residual;
+pub(crate) use crate::trajectory::energy_residual;
 
 /// What `afmdyn simulate --json` reports of a run (the front ends add their own keys, e.g. the
 /// files written and warnings).
@@ -105,7 +105,7 @@ pub(crate) fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> 
 }
 
 /// `simulate_summary` of a whole [`Trajectory`].
-pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
+pub(crate) fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
     simulate_summary(
         model,
         &SimulateSummary {
@@ -121,7 +121,7 @@ pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
 
 /// `afmdyn converge --json` without the output directory: the parameters and, per N, the
 /// period and the RMS change of the tip motion against N − 1.
-pub fn converge(params: &Params, runs: &[ConvergenceRun]) -> Value {
+pub(crate) fn converge(params: &Params, runs: &[ConvergenceRun]) -> Value {
     let rows: Vec<_> = runs
         .iter()
         .map(|r| json!({ "modes": r.modes, "period": r.period, "rms_change": r.rms_change }))
@@ -165,7 +165,7 @@ pub(crate) fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbi
 }
 
 /// `afmdyn attractors --json` (also written to `attractors.json`): `samples` starts at `params`.
-pub fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> Value {
+pub(crate) fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> Value {
     json!({
         "params": params,
         "samples": samples,
@@ -354,7 +354,7 @@ pub fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
 
 /// `afmdyn continue --json` without the output directory: the branches' sizes and their
 /// located bifurcations.
-pub fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Value {
+pub(crate) fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Value {
     let events: Vec<_> = branches
         .iter()
         .flatten()
@@ -398,7 +398,7 @@ pub use units::*;
 
 /// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
 /// [`LyapunovSpectrum`], so a field added there reaches both front ends).
-pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
+pub(crate) fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
     let mut doc = serde_json::to_value(l).expect("a Lyapunov spectrum serialises");
     doc["params"] = json!(params);
     doc

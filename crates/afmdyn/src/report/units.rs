@@ -4,7 +4,7 @@
 
 use super::*;
 
-/// Scales of a stepped-curve document ([`approach`], [`resonance`]): the factors that turn the
+/// Scales of a stepped-curve document (`approach`, `resonance`): the factors that turn the
 /// model's lengths (g₀), forces (F̃) and energies (F̃·g₀) into the reported units, and Ω into Hz.
 /// The one place the curves are converted.
 #[derive(Debug, Clone, Copy, PartialEq)]

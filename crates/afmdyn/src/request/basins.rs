@@ -176,7 +176,7 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
 /// basin fractions, failed cells, how the cells were decided, the drive periods run, basin
 /// entropy S_b and boundary basin entropy S_bb (boxes of `ENTROPY_BOX`² cells; null when no
 /// box fits) and the uncertainty exponent (null when no cell is uncertain).
-pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
+pub(crate) fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
     let nx = spec.xs.len();
     let labels = map.labels();
     let entropy = basin_entropy(&labels, nx, ENTROPY_BOX);

@@ -257,7 +257,7 @@ pub struct Chart {
     pub slots: usize,
     /// The cells' parameters.
     pub model: ChartModel,
-    /// What a resumed chart must match ([`fingerprint`]).
+    /// What a resumed chart must match (`fingerprint`).
     pub fingerprint: Value,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
@@ -455,7 +455,7 @@ fn read_probe(probe: Option<&str>) -> Result<(Option<toml::Table>, Option<Probe>
 
 /// The fingerprint of a chart: everything that determines its cells (the library's version,
 /// the model values, the probe, every chart option but the threads).
-pub fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
+pub(crate) fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
     let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
     if let Some(map) = r.as_object_mut() {
         map.remove("threads");

@@ -1,6 +1,6 @@
 //! Checkpoints of a bifurcation sweep: a sweep writes each finished point to a store, and an
 //! interrupted sweep resumes from it, computing exactly the points not yet stored — only when
-//! the request is the one that made the store (its [`fingerprint`]).
+//! the request is the one that made the store (its `fingerprint`).
 //!
 //! A store implements [`Checkpoint`]; [`MemoryCheckpoint`] keeps the records in memory, and
 //! with the `files` feature `super::checkpoint_file::FileCheckpoint` keeps them in a
@@ -9,8 +9,6 @@
 //! [`open`] decides where a sweep stands in its store; the sweep is a study
 //! ([`crate::study::sweep::SweepStudy`]) that [`crate::study::execute`] computes into it, and
 //! [`Checkpoint::finish`] puts the rows in the one order (`super::sweep::order_key`).
-//!
-//! [`fingerprint`]: super::sweep::fingerprint
 
 use super::sweep::{first_difference, SweepRecord};
 use crate::analysis::bifurcation::{Branch, Resume, SweepSpec};

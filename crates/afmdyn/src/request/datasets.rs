@@ -334,7 +334,7 @@ impl Datasets for ResonanceRequest {
 }
 
 impl Datasets for FmRequest {
-    /// The curve's layout `fm` from its document ([`super::fm::layout`]).
+    /// The curve's layout `fm` from its document (`super::fm::layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         let doc = super::fm::document(self, model, curve);
         one("fm", super::fm::layout(&doc))
@@ -342,7 +342,7 @@ impl Datasets for FmRequest {
 }
 
 impl Datasets for ReconstructRequest {
-    /// The reconstruction's layout `reconstruct` ([`super::reconstruct::layout`], with the
+    /// The reconstruction's layout `reconstruct` (`super::reconstruct::layout`, with the
     /// request's `law_force`).
     fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
         let layout = super::reconstruct::layout(r, self.law_in_order());

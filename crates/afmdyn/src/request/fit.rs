@@ -6,7 +6,7 @@
 //! needed (the lever's spring constant, the start values and the held parameters).
 
 use super::fit_result::probe_value;
-pub use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
+pub(crate) use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
@@ -633,7 +633,7 @@ impl Analysis for FitRequest {
 /// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
 /// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
 /// `method`, `warnings`; SI throughout.
-pub fn document(request: &FitRequest, r: &FitResult) -> Value {
+pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
     let end = |e: ProfileEnd| match e {
         ProfileEnd::Crossing(_) => "crossing",
         ProfileEnd::Bound(_) => "bound",

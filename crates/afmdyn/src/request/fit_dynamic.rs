@@ -15,7 +15,7 @@
 //! curve beside the data with its residuals, warnings).
 
 use super::fit_result::{bounds, probe_value, FitResult, MIN_FIT_ROWS};
-pub use super::fit_result::{AmData, DynamicFit, CURVE_VARIABLES};
+pub(crate) use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
@@ -179,7 +179,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz, DMT or JKR
 /// sample; [`SimError::Cancelled`].
-pub fn execute(
+pub(crate) fn execute(
     fit: &[String],
     default_fit: bool,
     profiles: bool,
@@ -548,7 +548,7 @@ pub(crate) fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) ->
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built; [`SimError::Budget`] beyond the request
 /// budget, advising fewer rows or parameters, or no profiles.
-pub fn cost(
+pub(crate) fn cost(
     rows: usize,
     fitted: usize,
     profiles: bool,
@@ -590,7 +590,12 @@ pub fn cost(
 /// `amplitude_residual`, `phase`, …, or `frequency_shift`, `frequency_shift_fit`,
 /// `frequency_shift_residual` (Hz)), `preprocessing` (none; the lever's `spring_constant`),
 /// `kind` = `"am"` or `"fm"`, `law`, `units`, `method`, `warnings`.
-pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Value) -> Value {
+pub(crate) fn document(
+    r: &FitResult,
+    d: &DynamicFit,
+    estimates: Value,
+    correlation: Value,
+) -> Value {
     let o = &r.outcome;
     let m = d.data.z.len();
     let mut curve = serde_json::Map::new();

@@ -283,7 +283,7 @@ impl Analysis for FmRequest {
 /// per quantity, one entry per z_c reached), `folds`, `reference` (the free lever's operating
 /// point), the cantilever's constants that [`super::reconstruct`] needs (`spring_constant`,
 /// `resonance_frequency`, `amplitude`), `units`, `method`, `warnings`.
-pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
+pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
     let u = FmRequest::units(model);
     let hz = u.hz_per_omega.unwrap_or(1.0);
     let p = &curve.points;
@@ -468,7 +468,7 @@ const FM_VARIABLES: [(&str, Unit, &str); 17] = [
 /// model's without: `units`; `deg` for the phase, `1` for the pure numbers, the length's and
 /// force's units for the mean deflection and indentation, and for the mean and law forces);
 /// `stable` flags, `iterations` integers, `null` as NaN. What Python's `afmdyn.fm` returns.
-pub fn layout(doc: &Value) -> crate::layout::Layout {
+pub(crate) fn layout(doc: &Value) -> crate::layout::Layout {
     use crate::layout::{Layout, Values, Variable};
     let curve = &doc["curve"];
     let list = |name: &str| curve[name].as_array().cloned().unwrap_or_default();

@@ -51,7 +51,7 @@ mod sample;
 mod study;
 pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy, MAX_STUDY_RATIOS};
 
-pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
+pub(crate) use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
 /// Largest number of domains of a sample map.
 pub(crate) const MAX_DOMAINS: usize = 1000;

@@ -102,7 +102,7 @@ fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
 /// background) and `domain` (0 the background, k the map's k-th domain), each 32-bit integer
 /// codes with their CF `flag_values` and `flag_meanings`; the scalars `setpoint` (A_sp/A₀, as
 /// given) and `reference_z_c` (m).
-pub fn layout(img: &Image, setpoint: f64) -> Layout {
+pub(crate) fn layout(img: &Image, setpoint: f64) -> Layout {
     let (nx, ny) = (img.x.len(), img.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
     let point = |get: fn(&OperatingPoint) -> f64| -> Vec<f64> {

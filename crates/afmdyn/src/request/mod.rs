@@ -20,7 +20,7 @@
 //!   a request's cost ([`limits::Cost`]), which `costs` estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
-//! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
+//! - [`checkpoint`]: resumable sweeps: the `Checkpoint` a store implements, in memory or
 //!   (feature `files`) in a directory (`checkpoint_file`), locked for one run at a time
 //!   ([`crate::io::dir_lock`]).
 //!
@@ -42,7 +42,7 @@ pub(crate) mod curve_layout;
 pub mod curves;
 mod datasets;
 #[cfg(feature = "files")]
-pub use crate::io::dir_lock;
+pub(crate) use crate::io::dir_lock;
 pub mod fm;
 #[cfg(feature = "files")]
 pub use crate::io::height_map as height_map_file;
@@ -82,7 +82,8 @@ pub use analyses::{
 };
 pub use basins::{BasinArrays, BasinsRequest};
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
-pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
+#[cfg(feature = "files")]
+pub(crate) use checkpoint::MemoryCheckpoint;
 #[cfg(feature = "files")]
 pub(crate) use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
@@ -100,13 +101,11 @@ pub use run::{
     admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document, Resolved,
     ResonanceRequest,
 };
-pub use sweep::{fingerprint, SweepRecord};
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a
 // run counts in, the results the curve and reconstruction requests return, the integrators a
 // request names, and the contact laws' registry with the force's sign convention
 pub use crate::analysis::progress::Progress;
-pub use crate::analysis::reconstruct::Reconstruction;
 pub use crate::analysis::stepped::SteppedCurve;
 pub use crate::contact::{LawGroups, LawKind, FORCE_SIGN, GROUPS, LAWS};
 pub use crate::integrate::IntegratorKind;

@@ -184,7 +184,7 @@ const AFTER_GROUPS: [ParamInfo; 2] = [
 
 /// Every model parameter a request takes, in the order the front ends list them: the model's
 /// own, the law groups of the registry ([`crate::contact::GROUPS`], each described by its
-/// law's [`crate::contact::Param`]), then `z_c` and `drive_frequency`, SI values that need a
+/// law's `crate::contact::Param`), then `z_c` and `drive_frequency`, SI values that need a
 /// probe file. The ranges are those [`Params::validate`] and [`ContactLaw::validate`] enforce.
 pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::LazyLock::new(|| {
     let groups = GROUPS.iter().map(|g| ParamInfo {
@@ -623,7 +623,7 @@ fn omega_of_drive_frequency(f: f64, probe: Option<&Probe>) -> Result<f64, SimErr
 /// The model values a probe file sets in SI, refused as dimensionless values when a probe is
 /// given (its scales would not apply to them: `hamaker = 6.6e-20` taken as H̃ is not the
 /// Hamaker constant in J): the value's name and what to give instead. The law's groups say
-/// it themselves ([`crate::contact::Param::under_probe`], `probe_sets`). `modes`,
+/// it themselves (`crate::contact::Param::under_probe`, `probe_sets`). `modes`,
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
 pub const PROBE_SETS: [(&str, &str); 9] = [

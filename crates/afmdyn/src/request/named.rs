@@ -11,7 +11,9 @@
 //! curve of a multifrequency drive (`super::curves::check_bimodal`).
 
 use super::reconstruct_document::FromDocument;
-use super::run::{document, run, Analysis, Resolved};
+#[cfg(feature = "files")]
+use super::run::document;
+use super::run::{run, Analysis, Resolved};
 use super::{
     ApproachRequest, AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
     FmRequest, GlobalContinuationRequest, LyapunovRequest, ModesRequest, ObserveRequest,
@@ -248,7 +250,8 @@ pub fn default_request(name: &str) -> Option<Value> {
 ///
 /// # Errors
 /// As [`document`] and [`Datasets::datasets`].
-pub fn outcome<A: Datasets>(
+#[cfg(feature = "files")]
+pub(crate) fn outcome<A: Datasets>(
     request: &A,
     model: &Resolved,
     output: &A::Output,

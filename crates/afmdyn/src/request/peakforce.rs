@@ -379,7 +379,7 @@ pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
 /// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
 /// (time, deflection, distance, force from the largest separation) and `curve` (the
 /// force–distance curve, approach and retract), `z_c`, `units`, `method`, `warnings`.
-pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
+pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
     let u = PeakForceRequest::units(model);
     let tap = &r.tap;
     let c = &tap.channels;

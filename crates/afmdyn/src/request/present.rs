@@ -11,7 +11,7 @@ pub(crate) mod census;
 #[cfg(feature = "files")]
 pub(crate) mod continuation;
 #[cfg(feature = "files")]
-pub mod converge;
+pub(crate) mod converge;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fit;

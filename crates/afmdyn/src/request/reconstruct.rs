@@ -235,7 +235,7 @@ impl ReconstructRequest {
 }
 
 impl ReconstructRequest {
-    /// The request of an `afmdyn fm` document in SI ([`super::fm::document`]): the distances
+    /// The request of an `afmdyn fm` document in SI (`super::fm::document`): the distances
     /// of closest approach `curve.min_distance` (the lower turning points, static deflection
     /// included), `curve.frequency_shift`, and the document's `spring_constant`,
     /// `resonance_frequency` and `amplitude` — each of the three replaced by the value given.
@@ -418,7 +418,7 @@ impl Analysis for AmReconstruction {
 /// `sader_jarvis_residual`, `forward_residual`, `converged`).
 ///
 /// [`ExactRecord`]: crate::analysis::reconstruct::ExactRecord
-pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
+pub(crate) fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
     let mut force = json!({"distance": r.distance, "force": r.force, "potential": r.potential});
     if let Some(law) = request.law_in_order() {
         force["law"] = json!(law);
@@ -609,7 +609,7 @@ const RECONSTRUCT_VARIABLES: [(&str, &str, &str); 3] = [
 /// (N; with `law`, the model's force at each distance in that order:
 /// `ReconstructRequest::law_in_order`), `force` (N) and `potential` (J), SI as the
 /// documents.
-pub fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
+pub(crate) fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
     use crate::layout::{Layout, Variable};
     let d = ["distance"];
     let mut variables = vec![Variable::f64(

@@ -5,7 +5,7 @@
 //! the length of the run. Its [`Analysis`] checks the series' bytes against the files' budget
 //! ([`SeriesStore::Files`]) and the run's cost before any work; `execute` is the run itself
 //! (it writes the data files into `dir`), `present` the spectrum, the figures and the summary
-//! (its presentation, [`simulate`], is here too).
+//! (its presentation, `simulate`, is here too).
 
 use super::analyses::{initial_state, SeriesStore, SimulateRequest, SimulateSpan};
 use super::costs::{state_bytes, MODEL_BYTES};
@@ -372,7 +372,7 @@ impl PlotData {
 ///
 /// # Errors
 /// [`SimError`] when the model cannot be built.
-pub fn simulate(
+pub(crate) fn simulate(
     run: &SimulateStream,
     model: &Resolved,
     r: &SimulateRecording,

@@ -10,6 +10,7 @@
 
 use super::analyses::BifurcationRequest;
 use crate::analysis::bifurcation::{Branch, SweepPoint, SweepSpec};
+#[cfg(feature = "files")]
 use crate::layout::{Layout, Values, Variable};
 use crate::params::SweepParam;
 use serde_json::{json, Value};
@@ -355,7 +356,8 @@ pub(crate) fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
 /// `point`), `n_points` (`points`), `tau` … `contacts_per_period`, `transient_periods` (−1 for
 /// a failed point), `message` — and the state as `a_1` … `a_N`, `a_dot_1` … `a_dot_N` (NaN
 /// for a failed point).
-pub fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
+#[cfg(feature = "files")]
+pub(crate) fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
     // a number's unit and meaning as the numeric columns give them (`period` as its code),
     // a word's as the CSV's
     let meaning = |name: &str, numeric: bool| {
@@ -546,7 +548,7 @@ impl SweepRecord {
 /// is resumed only with the same fingerprint. The worker threads are not part of it.
 ///
 /// The values are `from`, `to`, `steps`, or `values` when the request lists them.
-pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
+pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
     let mut doc = json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         // how the sweep is cut into tasks and its starts keyed (issue 29): a store written by

@@ -32,13 +32,13 @@ pub struct BasinStudy {
     pub spec: BasinSpec,
     /// The cantilever of `spec.params`.
     pub model: CantileverModel,
-    /// What a resumed map must match ([`fingerprint`]).
+    /// What a resumed map must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a basin map: everything that determines its cells (the library's
 /// version, the model values, every option of the request but the threads).
-pub fn fingerprint(request: &BasinsRequest, params: &Params) -> Value {
+pub(crate) fn fingerprint(request: &BasinsRequest, params: &Params) -> Value {
     let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
     if let Some(map) = r.as_object_mut() {
         map.remove("threads");

@@ -20,6 +20,6 @@ pub(crate) const CHART_FILES: TaskFiles = TaskFiles {
 pub(crate) type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
 
 /// The chart store of the directory `lock` holds.
-pub fn chart_store(lock: &DirLock) -> ChartStore<'_> {
+pub(crate) fn chart_store(lock: &DirLock) -> ChartStore<'_> {
     TaskStore::new(lock, CHART_FILES)
 }

@@ -32,13 +32,13 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 pub struct ContinuationStudy {
     /// The validated continuation.
     pub spec: GlobalContinuationSpec,
-    /// What a resumed continuation must match ([`fingerprint`]).
+    /// What a resumed continuation must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a global continuation: everything that determines its steps (the
 /// library's version, the model values, every option of the request).
-pub fn fingerprint(request: &GlobalContinuationRequest, params: &Params) -> Value {
+pub(crate) fn fingerprint(request: &GlobalContinuationRequest, params: &Params) -> Value {
     json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         "global_continuation": request,

@@ -24,7 +24,7 @@
 //!   [`global_continuation`] (a global continuation's values, one chain, its store
 //!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance
 //!   curve's points, one chain through both sweeps, its store `stepped::curve_store`) and
-//!   [`peakforce`] (a PeakForce sweep's taps, one chain, run in memory). A chain's resume reads its stored records back (its next task starts from them: `Done` is
+//!   `peakforce` (a PeakForce sweep's taps, one chain, run in memory). A chain's resume reads its stored records back (its next task starts from them: `Done` is
 //!   the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
@@ -40,9 +40,9 @@ pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
 pub mod global_continuation;
-pub mod image;
+pub(crate) mod image;
 mod memory;
-pub mod peakforce;
+pub(crate) mod peakforce;
 pub mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;

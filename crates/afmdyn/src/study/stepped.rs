@@ -38,13 +38,13 @@ use std::sync::atomic::AtomicBool;
 pub struct CurveStudy {
     /// The validated sweep.
     pub spec: SteppedSpec,
-    /// What a resumed curve must match ([`fingerprint`]).
+    /// What a resumed curve must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a stepped curve: everything that determines its points (the library's
 /// version, the kind of curve and its request, the model values and the probe).
-pub fn fingerprint(kind: &str, request: &impl Serialize, model: &Resolved) -> Value {
+pub(crate) fn fingerprint(kind: &str, request: &impl Serialize, model: &Resolved) -> Value {
     json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         kind: request,

@@ -25,7 +25,7 @@ use std::sync::atomic::AtomicBool;
 pub struct SweepStudy {
     /// The validated sweep.
     pub spec: SweepSpec,
-    /// What a resumed sweep must match ([`crate::request::sweep::fingerprint`]).
+    /// What a resumed sweep must match (`crate::request::sweep::fingerprint`).
     pub fingerprint: Value,
 }
 

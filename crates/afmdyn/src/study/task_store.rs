@@ -84,7 +84,7 @@ fn io<'p>(
 
 /// A study's store of records `R` in the directory its lock holds.
 #[derive(Debug)]
-pub struct TaskStore<'a, R> {
+pub(crate) struct TaskStore<'a, R> {
     files: TaskFiles,
     lock: &'a DirLock,
     writer: Option<BufWriter<File>>,
@@ -158,7 +158,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// # Errors
     /// [`CheckpointError::Mismatch`] naming the first field that differs,
     /// [`CheckpointError::Unrecorded`] for tasks without a ledger, and the files' errors.
-    pub fn open(
+    pub(crate) fn open(
         &mut self,
         fingerprint: &Value,
         resume: bool,
@@ -306,7 +306,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`].
-    pub fn append(&mut self, task: usize, record: &R) -> Result<(), CheckpointError> {
+    pub(crate) fn append(&mut self, task: usize, record: &R) -> Result<(), CheckpointError> {
         let path = self.path(self.files.records);
         let mut line = serde_json::Map::new();
         line.insert("task".into(), json!(task));
@@ -338,7 +338,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`].
-    pub fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
+    pub(crate) fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
         if let Some(w) = self.writer.as_mut() {
             let path = self.lock.path().join(self.files.records);
             w.flush().map_err(io("write", &path))?;
@@ -350,7 +350,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// As the ledger's reading.
-    pub fn finished(&self) -> Result<bool, CheckpointError> {
+    pub(crate) fn finished(&self) -> Result<bool, CheckpointError> {
         Ok(self.ledger()?.is_some_and(|l| l.finished))
     }
 
@@ -358,7 +358,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`]; [`CheckpointError::Corrupt`] for a damaged line.
-    pub fn records(&mut self) -> Result<Vec<(usize, R)>, CheckpointError> {
+    pub(crate) fn records(&mut self) -> Result<Vec<(usize, R)>, CheckpointError> {
         if let Some(w) = self.writer.as_mut() {
             let path = self.lock.path().join(self.files.records);
             w.flush().map_err(io("write", &path))?;

@@ -19,7 +19,7 @@
 //!
 //! # Model
 //! F(x) = baseline + F_c(δ), δ = contact_point − x (the indentation), F_c the law's force of
-//! the registry ([`crate::contact::Law::force`]) evaluated in SI: its Hertz group
+//! the registry (`crate::contact::Law::force`) evaluated in SI: its Hertz group
 //! k_H = (4/3)E*√R (Hertz 1882; Sneddon, *Int. J. Eng. Sci.* 3 (1965) 47, eq. 6.9: the
 //! paraboloid F = (4/3) E/(1 − ν²) √R δ^{3/2} of a rigid tip), 1/E* = (1 − ν_t²)/E_t +
 //! (1 − ν_s²)/E_s (Johnson, *Contact Mechanics*, 1985, eq. 4.22); DMT's van der Waals group

@@ -120,7 +120,7 @@ pub struct Profile {
 /// A least-squares fit at its minimum, as a profile walks about it: the model, the
 /// observations and the parameters, the minimum `best`, the parameters `fixed` in the fit, and
 /// `s2`, which scales χ² (the noise variance, 1 with σ given).
-pub struct Fitted<'a> {
+pub(crate) struct Fitted<'a> {
     /// The model fitted.
     pub model: &'a dyn CurveModel,
     /// The observations.
@@ -143,7 +143,7 @@ pub struct Fitted<'a> {
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled.
-pub fn profile(
+pub(crate) fn profile(
     fit: &Fitted,
     j: usize,
     step: f64,

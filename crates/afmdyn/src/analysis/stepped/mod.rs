@@ -38,7 +38,7 @@ use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
 use crate::analysis::progress::Progress;
-pub use crate::analysis::settle::Found;
+pub(crate) use crate::analysis::settle::Found;
 use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
 use crate::analysis::shooting::{
     broyden_pays, shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,

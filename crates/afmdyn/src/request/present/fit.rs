@@ -40,7 +40,7 @@ fn estimate_line(name: &str, e: &Value, unit: &str, text: TextUnits) -> String {
 
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
-pub fn fit(
+pub(crate) fn fit(
     document: &mut Value,
     text: TextUnits,
     files: Files,

@@ -12,7 +12,12 @@ use std::path::Path;
 /// `files` the table `fm.csv`, the figure (all files) and the document `fm.json`; when the
 /// files go to `dir`, the document records the table's path there (`"csv"`, in the document
 /// printed too).
-pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path>) -> Presentation {
+pub(crate) fn fm(
+    document: &mut Value,
+    text: TextUnits,
+    files: Files,
+    dir: Option<&Path>,
+) -> Presentation {
     let mut p = Presentation {
         outputs_note: OutputsNote::Tail,
         ..Presentation::default()
@@ -103,7 +108,7 @@ pub const COLUMNS: [&str; 18] = [
     "iterations",
 ];
 
-/// The rows of the table of an FM document ([`crate::request::fm::document`]), one per point, in [`COLUMNS`]
+/// The rows of the table of an FM document (`crate::request::fm::document`), one per point, in [`COLUMNS`]
 /// order.
 pub fn rows(doc: &Value) -> Vec<Vec<f64>> {
     let curve = &doc["curve"];

@@ -405,7 +405,7 @@ pub(crate) fn peakforce_summary(img: &PeakForceImage) -> Value {
 /// [`PeakForceImage::document`]), `image.nc`, the maps `image-height`, `image-modulus`,
 /// `image-adhesion`, `image-deformation`, `image-dissipation`, and the summary: every
 /// material's engaged operating point beside its true modulus.
-pub fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
+pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
     let mut s = Presentation::default();
     s.json("image.json", document.clone());
     s.dataset("image.nc", peakforce_layout(img));

@@ -167,7 +167,7 @@ pub(crate) fn fig3(modes: usize, pts: &[crate::eigen::Fig3Point]) -> Presentatio
 }
 
 /// `units --config`: the dimensionless set of a physical model (eq. 7) and its scales (eq. 5).
-pub fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
+pub(crate) fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
     let mut s = Presentation::default();
     let k1 = model.contact_stiffness;
     s.line("dimensionless parameters (eq. 7):");
@@ -197,7 +197,7 @@ pub fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
 }
 
 /// `cantilevers`: the library of cantilevers, one line each, and how to use them.
-pub fn cantilevers() -> Presentation {
+pub(crate) fn cantilevers() -> Presentation {
     let mut s = Presentation::default();
     s.line(format!(
         "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",

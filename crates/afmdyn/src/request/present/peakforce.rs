@@ -94,7 +94,7 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
 /// The presentation of a steady tap's `document` ([`crate::request::peakforce::document`]):
 /// the summary, and with `files` the two tables, the figures (all files) and the document
 /// `peakforce.json`.
-pub fn peakforce(
+pub(crate) fn peakforce(
     document: &mut Value,
     text: TextUnits,
     files: Files,
