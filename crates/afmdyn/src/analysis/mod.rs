@@ -34,7 +34,7 @@ pub mod resonance;
 pub mod setpoint;
 pub mod settle;
 pub mod shooting;
-pub mod spectrum;
+pub(crate) mod spectrum;
 pub mod steady;
 pub mod stepped;
 pub(crate) mod tasks;
@@ -46,7 +46,7 @@ pub mod traces;
 ///
 /// # Errors
 /// [`crate::SimError::OutOfRange`] naming `name`.
-pub fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+pub(crate) fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
     if !(v.is_finite() && v > 0.0 && v < 1e-3) {
         return Err(crate::SimError::out_of_range(
             name,

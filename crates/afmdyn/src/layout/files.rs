@@ -2,7 +2,7 @@
 //! directory and is renamed into place, so a partial file is never mistaken for a finished one
 //! (a [`Stream`] dropped unfinished removes its temporary file), and every I/O error names its
 //! path ([`FileError`]). The tables: streamed CSV (`csv_stream`, `csv_line` with every
-//! number in its shortest round-trip form, [`f`]) and streamed 2-D float64 NPY arrays
+//! number in its shortest round-trip form, `f`) and streamed 2-D float64 NPY arrays
 //! ([`NpyStream`], the NPY format of numpy's `format.py`, byte for byte `npyz`'s writer) with
 //! their self-describing header files (`X.npy.json`: shape, dtype, each column's unit and
 //! meaning, [`Column`]).
@@ -364,7 +364,7 @@ impl NpyStream {
 /// (several times faster than the standard library's; a spectrum writes a million of them;
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
 /// notation (|v| near 1e-5), the standard formatting is used.
-pub fn f(v: f64) -> String {
+pub(crate) fn f(v: f64) -> String {
     let mut out = Vec::with_capacity(24);
     f_into(&mut out, v);
     String::from_utf8(out).expect("ASCII")

@@ -96,7 +96,7 @@ pub(crate) use crate::probe::ranges::MAX_SI_DISTANCE;
 /// MHz but written in Hz (1e3 or 1e6 too small).
 pub(crate) const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 
-pub use crate::analysis::tolerance;
+pub(crate) use crate::analysis::tolerance;
 
 /// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
 ///

@@ -110,7 +110,7 @@ pub const COLUMNS: [&str; 18] = [
 
 /// The rows of the table of an FM document (`crate::request::fm::document`), one per point, in [`COLUMNS`]
 /// order.
-pub fn rows(doc: &Value) -> Vec<Vec<f64>> {
+pub(crate) fn rows(doc: &Value) -> Vec<Vec<f64>> {
     let curve = &doc["curve"];
     let column = |name: &str| -> Vec<f64> {
         curve[name]

@@ -34,7 +34,7 @@ fn column(doc: &Value, block: &str, name: &str) -> Vec<f64> {
 
 /// The rows of one table of the document: `block`'s arrays in `columns` order, as long as the
 /// longest (NaN beyond a shorter one).
-pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
+pub(crate) fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
     let cols: Vec<Vec<f64>> = columns.iter().map(|c| column(doc, block, c)).collect();
     let n = cols.iter().map(Vec::len).max().unwrap_or(0);
     (0..n)
