@@ -98,7 +98,7 @@ impl ModeShapes {
     /// The first `n` modes, `n` in 1..=20 (checked by [`crate::Params::validate`] upstream).
     ///
     /// # Panics
-    /// If `n` is 0 or larger than [`MAX_MODES`].
+    /// If `n` is 0 or larger than `MAX_MODES`.
     pub fn new(n: usize) -> Self {
         assert!((1..=MAX_MODES).contains(&n), "modes must be in 1..=20");
         ModeShapes {
@@ -132,7 +132,7 @@ impl ModeShapes {
     }
 
     /// ∫₀¹ φ_i dξ: shape `[N]`.
-    pub fn integrals(&self) -> Vec<f64> {
+    pub(crate) fn integrals(&self) -> Vec<f64> {
         self.modes.iter().map(BeamMode::integral).collect()
     }
 

@@ -1,11 +1,11 @@
 //! The cantilever library (issue 28): nominal datasheet values of widely used tapping-mode,
 //! soft-tapping and biological-imaging cantilevers, embedded from `assets/cantilevers.toml`
 //! (each entry with its source). A probe file names one with `[cantilever] name = "…"`; the
-//! entry fills the keys the file leaves out ([`fill`]): `spring_constant`,
+//! entry fills the keys the file leaves out (`fill`): `spring_constant`,
 //! `resonance_frequency`, `quality_factor`, `[tip].radius`, the tip's elastic constants
-//! (silicon, [`SILICON_YOUNGS_MODULUS`], [`SILICON_POISSON_RATIO`]) and `model =
+//! (silicon, [`SILICON_YOUNGS_MODULUS`], `SILICON_POISSON_RATIO`) and `model =
 //! "point-mass"`. The file's own keys always win; a spring constant or resonance frequency
-//! beyond the maker's spread of the named lever's warns ([`calibration_warnings`]).
+//! beyond the maker's spread of the named lever's warns (`calibration_warnings`).
 
 use std::sync::OnceLock;
 
@@ -16,7 +16,7 @@ use std::sync::OnceLock;
 pub const SILICON_YOUNGS_MODULUS: f64 = crate::units::SILICON_TIP.youngs_modulus;
 /// Poisson's ratio of a silicon tip, from the one materials table
 /// ([`crate::units::SILICON_TIP`]: 0.27, the paper's).
-pub const SILICON_POISSON_RATIO: f64 = crate::units::SILICON_TIP.poisson_ratio;
+pub(crate) const SILICON_POISSON_RATIO: f64 = crate::units::SILICON_TIP.poisson_ratio;
 
 /// One cantilever of the library (SI units).
 #[derive(Debug, Clone, PartialEq)]
@@ -46,7 +46,7 @@ const LIBRARY: &str = include_str!("../assets/cantilevers.toml");
 /// # Panics
 /// Never for the embedded file (its reading is tested); a malformed entry would panic at the
 /// first call.
-pub fn cantilevers() -> &'static [Cantilever] {
+pub(crate) fn cantilevers() -> &'static [Cantilever] {
     static ALL: OnceLock<Vec<Cantilever>> = OnceLock::new();
     ALL.get_or_init(|| {
         let root: toml::Table = LIBRARY.parse().expect("the embedded cantilever library");
@@ -86,7 +86,7 @@ pub fn cantilevers() -> &'static [Cantilever] {
 ///
 /// # Errors
 /// A message naming the unknown cantilever and the library's names that contain it (or all).
-pub fn find(name: &str) -> Result<&'static Cantilever, String> {
+pub(crate) fn find(name: &str) -> Result<&'static Cantilever, String> {
     let key = |s: &str| s.trim().to_ascii_uppercase().replace(['_', ' '], "-");
     let want = key(name);
     let all = cantilevers();
@@ -119,7 +119,7 @@ pub fn find(name: &str) -> Result<&'static Cantilever, String> {
 ///
 /// # Errors
 /// The message of [`find`] for an unknown name, or one for a name that is not a string.
-pub fn fill(root: &toml::Table) -> Result<toml::Table, String> {
+pub(crate) fn fill(root: &toml::Table) -> Result<toml::Table, String> {
     let Some(cant) = root.get("cantilever").and_then(|c| c.as_table()) else {
         return Ok(root.clone());
     };
@@ -176,10 +176,10 @@ pub fn fill(root: &toml::Table) -> Result<toml::Table, String> {
 /// before it warns: a factor of 3 either way. Makers state k within about a factor of 2–3 of
 /// nominal (Olympus AC160TS-R3: 26 N/m nominal, 8.4–57 N/m), so a calibration outside it more
 /// likely belongs to another lever.
-pub const SPRING_CONSTANT_SPREAD: f64 = 3.0;
+pub(crate) const SPRING_CONSTANT_SPREAD: f64 = 3.0;
 /// The same for the resonance frequency: a factor of 1.5 either way (AC160TS-R3: 300 kHz
 /// nominal, 200–400 kHz).
-pub const RESONANCE_FREQUENCY_SPREAD: f64 = 1.5;
+pub(crate) const RESONANCE_FREQUENCY_SPREAD: f64 = 1.5;
 
 /// Warnings for a probe file that names a library lever (`[cantilever].name`, or the command
 /// line's `--cantilever`) and gives its own `spring_constant` or `resonance_frequency` beyond
@@ -189,7 +189,7 @@ pub const RESONANCE_FREQUENCY_SPREAD: f64 = 1.5;
 /// the file was written for another one. No warning without a name, for a name not in the
 /// library ([`fill`] refuses it) or for values that are not numbers (the probe reader refuses
 /// them).
-pub fn calibration_warnings(root: &toml::Table) -> Vec<String> {
+pub(crate) fn calibration_warnings(root: &toml::Table) -> Vec<String> {
     let Some(cant) = root.get("cantilever").and_then(|c| c.as_table()) else {
         return Vec::new();
     };

@@ -12,9 +12,9 @@
 //!
 //! # The registry
 //! A law is one module (its groups, force, potential, guards, jet piece and descriptors: the
-//! [`Law`] trait) and one line of the `laws!` registry below, which generates [`ContactLaw`]
+//! `Law` trait) and one line of the `laws!` registry below, which generates [`ContactLaw`]
 //! (one variant per law, serialized as `{"law": name, groups…}`), [`LawKind`], the parser, the
-//! static dispatch of every [`Law`] method and [`LAWS`], the descriptors the front ends read
+//! static dispatch of every `Law` method and [`LAWS`], the descriptors the front ends read
 //! (schema, CLI help, Python, docs, conformance suite). The laws, each documented in its module:
 //! [`linear`], [`hertz`], [`dmt`], [`electrostatic`], [`jkr`], [`capillary`], [`sls`],
 //! [`impact`].
@@ -102,7 +102,7 @@ macro_rules! laws {
                 }
             }
 
-            /// The law of this kind from a probe file's sample in SI ([`Law::from_si`]), with
+            /// The law of this kind from a probe file's sample in SI (`Law::from_si`), with
             /// α4 and α6.
             ///
             /// # Errors
@@ -121,7 +121,7 @@ macro_rules! laws {
             }
 
             /// Build the law, filling groups that are not given with the law's defaults
-            /// ([`Param::default`] of its [`Law::PARAMS`]).
+            /// (`Param::default` of its `Law::PARAMS`).
             pub fn with_groups(self, groups: LawGroups) -> ContactLaw {
                 match self {
                     $(
@@ -166,21 +166,21 @@ macro_rules! laws {
 
         law_methods! {
             [$( [$(#[cfg($cfg)])?] $Variant $Law [$($($field)*)?] )*]
-            /// Check the law's own groups ([`Law::validate`]).
+            /// Check the law's own groups (`Law::validate`).
             ///
             /// # Errors
             /// [`crate::error::ParamError::Law`] naming the group and its allowed range.
             fn validate() -> Result<(), crate::error::ParamError>;
-            /// Check the law's groups against the shared α4 and α6 ([`Law::validate_shared`]).
+            /// Check the law's groups against the shared α4 and α6 (`Law::validate_shared`).
             ///
             /// # Errors
             /// [`crate::error::ParamError::Law`] naming α4 or α6 and the range the law needs.
             fn validate_shared(alpha4: f64, alpha6: f64) -> Result<(), crate::error::ParamError>;
-            /// [`Law::force`] of the law.
+            /// `Law::force` of the law.
             fn law_force(k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval = force;
-            /// [`Law::potential`] of the law.
+            /// `Law::potential` of the law.
             fn law_potential(k: f64, contact: bool, delta: f64) -> f64 = potential;
-            /// [`Law::dissipative`] of the law, in contact.
+            /// `Law::dissipative` of the law, in contact.
             fn law_dissipative(k: f64, c: f64, delta: f64, rate: f64) -> f64 = dissipative;
             /// Whether the law exerts a force outside contact (DMT's, the electrostatic law's).
             fn acts_outside() -> bool;
@@ -189,7 +189,7 @@ macro_rules! laws {
             /// (contact at d = V_T ≤ 0).
             fn distance_offset() -> f64;
             /// The long-range attraction at tip–sample distance d > 0: [F(d), dF/dd, U(d)] with
-            /// F = −dU/dd ([`Law::long_range`]); zeros for the laws without one.
+            /// F = −dU/dd (`Law::long_range`); zeros for the laws without one.
             fn long_range(d: f64) -> [f64; 3];
             /// A hysteretic law's cycle ([`ContactLaw::release_distance`] > 0) in the law's
             /// units, with Hertz group `alpha4`: where the contact is left, the largest pull and
@@ -208,12 +208,12 @@ macro_rules! laws {
             /// Whether the contact damper is Kelvin–Voigt's α6 √δ δ̇ (DMT, electrostatic,
             /// capillary): its ∂/∂δ is singular at the contact's onset.
             fn kelvin_voigt() -> bool;
-            /// The law's piece of the Taylor jet ([`Law::jet`]), with α4 `k` and α6 `c`.
+            /// The law's piece of the Taylor jet (`Law::jet`), with α4 `k` and α6 `c`.
             fn jet(k: f64, c: f64) -> Option<JetLaw>;
-            /// Why the Taylor integrator refuses the law ([`Law::taylor_hint`]).
+            /// Why the Taylor integrator refuses the law (`Law::taylor_hint`).
             fn taylor_hint() -> &'static str;
             /// Why the law does not apply in a liquid medium, if it does not
-            /// ([`Law::not_in_liquid`]: the capillary meniscus, the electrostatic force).
+            /// (`Law::not_in_liquid`: the capillary meniscus, the electrostatic force).
             fn not_in_liquid() -> Option<&'static str>;
         }
     };
@@ -224,7 +224,7 @@ macro_rules! laws {
 macro_rules! prepared_contact {
     ([$( [$(#[cfg($cfg:meta)])?] $Variant:ident $Law:ident [$($field:ident)*] )*]) => {
         /// A law with its constants prepared once from its groups and α4, α6
-        /// ([`ContactLaw::prepare`]): each variant holds its law's [`Law::Prepared`].
+        /// ([`ContactLaw::prepare`]): each variant holds its law's `Law::Prepared`.
         #[derive(Debug, Clone, Copy, PartialEq)]
         pub enum PreparedContact {
             $(
@@ -235,7 +235,7 @@ macro_rules! prepared_contact {
         }
 
         impl ContactLaw {
-            /// The law's prepare step ([`Law::prepare`]) with α4 = `alpha4` and α6 = `alpha6`:
+            /// The law's prepare step (`Law::prepare`) with α4 = `alpha4` and α6 = `alpha6`:
             /// its constants, computed once per model.
             pub fn prepare(&self, alpha4: f64, alpha6: f64) -> PreparedContact {
                 match *self {
@@ -325,13 +325,11 @@ mod prepared;
 pub use capillary::{
     Meniscus, CAPILLARY_DEFAULT_FORCE, CAPILLARY_DEFAULT_MENISCUS, CAPILLARY_DEFAULT_RUPTURE,
 };
-pub use dmt::PreparedDmt;
 pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VACUUM_PERMITTIVITY};
-pub use impact::IMPACT_DEFAULT_RESTITUTION;
 pub use jkr::{Jkr, PreparedJkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
 pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
-pub use prepared::{AsGiven, PreparedForce, PreparedLaw};
+pub(crate) use prepared::{AsGiven, PreparedForce, PreparedLaw};
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {
@@ -348,7 +346,7 @@ impl Default for LawKind {
     }
 }
 
-/// The tip force as the Taylor recurrences carry it ([`Law::jet`]; the recurrences are
+/// The tip force as the Taylor recurrences carry it (`Law::jet`; the recurrences are
 /// `integrate::taylor`'s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum JetLaw {
@@ -379,7 +377,7 @@ impl ContactLaw {
     }
 
     /// The law's descriptor in [`LAWS`].
-    pub fn info(&self) -> &'static LawInfo {
+    pub(crate) fn info(&self) -> &'static LawInfo {
         self.kind().info()
     }
 
@@ -473,7 +471,7 @@ impl LawKind {
     };
 
     /// The kind's descriptor in [`LAWS`].
-    pub fn info(self) -> &'static LawInfo {
+    pub(crate) fn info(self) -> &'static LawInfo {
         let i = LawKind::ALL
             .iter()
             .position(|&k| k == self)
@@ -535,8 +533,8 @@ const fn group_count() -> usize {
 }
 
 /// Every law group, once, in registry order (a group two laws share, as DMT's `hamaker`, is
-/// described by its first law's [`Param`]): the names requests, config files, CLI flags,
-/// Python keywords and the schema take, all derived from the laws' [`Law::PARAMS`].
+/// described by its first law's `Param`): the names requests, config files, CLI flags,
+/// Python keywords and the schema take, all derived from the laws' `Law::PARAMS`.
 pub const GROUPS: [Param; group_count()] = {
     let mut out = [Param::EMPTY; group_count()];
     let mut n = 0;
@@ -570,7 +568,7 @@ pub struct LawGroups([Option<f64>; GROUPS.len()]);
 
 impl LawGroups {
     /// The groups of `law` (those it has), e.g. to keep them when another group is changed.
-    pub fn of(law: ContactLaw) -> LawGroups {
+    pub(crate) fn of(law: ContactLaw) -> LawGroups {
         law.groups()
     }
 
@@ -603,12 +601,12 @@ impl LawGroups {
     }
 
     /// Each group by its name ([`Param::name`]), given or not, in the order of [`GROUPS`].
-    pub fn entries(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
+    pub(crate) fn entries(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
         GROUPS.iter().zip(self.0).map(|(p, v)| (p.name, v))
     }
 
     /// The groups given, by name, in the order of [`GROUPS`].
-    pub fn given(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+    pub(crate) fn given(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
         self.entries().filter_map(|(name, v)| Some((name, v?)))
     }
 
@@ -625,7 +623,7 @@ impl ContactLaw {
     ///
     /// # Errors
     /// [`crate::error::ParamError::Group`] for a group of another law (e.g. `restitution` with
-    /// `contact_law = hertz`), naming the laws that own it ([`LawInfo::params`]); the groups'
+    /// `contact_law = hertz`), naming the laws that own it (`LawInfo::params`); the groups'
     /// ranges are checked by [`ContactLaw::validate`].
     pub fn from_parts(
         kind: Option<LawKind>,

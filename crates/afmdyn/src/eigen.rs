@@ -52,7 +52,10 @@ pub fn natural_modes(m: &RegionMatrices) -> NaturalModes {
 /// units of EI/L³ (the paper) or k (the point mass, where it is 1). β₁⁴/4 = 3.09 for the bare
 /// beam against the static 3EI/L³. One place for the calibration of probes and the closed forms
 /// of the observables.
-pub fn first_mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>) -> (f64, DVector<f64>, f64) {
+pub(crate) fn first_mode_at_tip(
+    m: &RegionMatrices,
+    tip: &DVector<f64>,
+) -> (f64, DVector<f64>, f64) {
     mode_at_tip(m, tip, 0)
 }
 
@@ -76,7 +79,7 @@ pub(crate) fn beam_damping_for_q(
     omega1 / (q1 * s_x1)
 }
 
-/// [`first_mode_at_tip`] for mode `k` (0-based, k < N): ω̃_k, the mass-normalised undamped
+/// `first_mode_at_tip` for mode `k` (0-based, k < N): ω̃_k, the mass-normalised undamped
 /// mode x_k and the stiffness k̃_k = ω̃_k²/(φᵀx_k)² of the equivalent point mass of that mode
 /// at the tip (Melcher, Hu & Raman, *Appl. Phys. Lett.* 91 (2007) 053101).
 ///
@@ -150,7 +153,7 @@ pub fn damped_eigenvalues(m: &RegionMatrices) -> Vec<DampedEigenvalue> {
 /// frequency ω̃_k ([`natural_modes`]) the underdamped damped eigenvalue λ (eqs. 20–21) whose
 /// modulus is nearest it (|λ| = ω̃_k for modal damping); `None` for an overdamped mode (Q < 1/2:
 /// no underdamped eigenvalue within ω̃_k/2 of it).
-pub fn quality_factors(m: &RegionMatrices) -> Vec<Option<f64>> {
+pub(crate) fn quality_factors(m: &RegionMatrices) -> Vec<Option<f64>> {
     let eig: Vec<DampedEigenvalue> = damped_eigenvalues(m)
         .into_iter()
         .filter(|e| e.im > 0.0)

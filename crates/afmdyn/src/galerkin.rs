@@ -24,16 +24,6 @@ pub struct Forcing {
     pub cos: DVector<f64>,
 }
 
-impl Forcing {
-    /// F(τ) for drive frequency `omega`, written into `out` (shape `[N]`).
-    pub fn eval_into(&self, omega: f64, tau: f64, out: &mut DVector<f64>) {
-        let (s, c) = (omega * tau).sin_cos();
-        out.copy_from(&self.constant);
-        out.axpy(s, &self.sin, 1.0);
-        out.axpy(c, &self.cos, 1.0);
-    }
-}
-
 /// Galerkin matrices of one region (eq. 10): mass, damping, stiffness (N×N) and forcing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RegionMatrices {
@@ -62,7 +52,7 @@ impl Galerkin {
     /// Assemble both regions' matrices.
     ///
     /// # Errors
-    /// [`ParamError`] if `params` fails validation ([`Params::validate_fields`]: the matrices do
+    /// [`ParamError`] if `params` fails validation (`Params::validate_fields`: the matrices do
     /// not depend on the drive's common period).
     pub fn new(params: &Params) -> Result<Self, ParamError> {
         params.validate_fields()?;
@@ -144,11 +134,6 @@ impl Galerkin {
         &self.tip
     }
 
-    /// ∫₀¹ φ_i dξ, shape `[N]`.
-    pub fn integrals(&self) -> &DVector<f64> {
-        &self.integrals
-    }
-
     /// Matrices of one region.
     pub fn region(&self, r: Region) -> &RegionMatrices {
         match r {
@@ -166,7 +151,7 @@ impl Galerkin {
     /// (F(p + δ) − F(p − δ)) / 2δ is the derivative exactly, for any δ; the same formulas are
     /// evaluated at p ± δ with δ = 1 + |p|, so the derivative is exact up to round-off and the
     /// formulas exist once.
-    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[Forcing; 2]> {
+    pub(crate) fn forcing_derivative(&self, param: SweepParam) -> Option<[Forcing; 2]> {
         let p0 = self.params;
         let value = match param {
             SweepParam::Omega => p0.omega,
@@ -184,7 +169,7 @@ impl Galerkin {
     /// sample's damping do not move with α3), and ∂F_s/∂α3 of the free and the contact region
     /// (the base velocity's −α2 α3 s_i ∫φ_i cos Ωτ of eq. 14; 0 under a force drive), linear in
     /// α3, so the central difference of [`Galerkin::forcing_derivative`] is exact.
-    pub fn damping_derivative(&self) -> (DVector<f64>, [Forcing; 2]) {
+    pub(crate) fn damping_derivative(&self) -> (DVector<f64>, [Forcing; 2]) {
         let p = &self.params;
         (
             self.damping_profile(),

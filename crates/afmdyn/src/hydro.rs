@@ -37,9 +37,9 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Smallest Reynolds number of Sader's fit Ω (module docs).
-pub const MIN_REYNOLDS: f64 = 1e-6;
+pub(crate) const MIN_REYNOLDS: f64 = 1e-6;
 /// Largest Reynolds number of Sader's fit Ω.
-pub const MAX_REYNOLDS: f64 = 1e4;
+pub(crate) const MAX_REYNOLDS: f64 = 1e4;
 
 /// A Newtonian fluid around the cantilever.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -74,7 +74,7 @@ impl Medium {
         self.density >= LIQUID_DENSITY
     }
 
-    /// A preset by name ([`MEDIA`], case-insensitive).
+    /// A preset by name (`MEDIA`, case-insensitive).
     ///
     /// # Errors
     /// [`UnitsError::Choice`] naming `medium` and listing the presets.
@@ -126,7 +126,7 @@ pub fn with_medium(text: &str, name: &str) -> Result<String, String> {
 }
 
 /// The media by name: `water`, `air` ([`Medium::WATER`], [`Medium::AIR`]).
-pub const MEDIA: [(&str, Medium); 2] = [("water", Medium::WATER), ("air", Medium::AIR)];
+pub(crate) const MEDIA: [(&str, Medium); 2] = [("water", Medium::WATER), ("air", Medium::AIR)];
 
 /// Check that `re` lies in Sader's range [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]].
 fn check_reynolds(re: f64) -> Result<f64, SimError> {
@@ -145,7 +145,7 @@ fn check_reynolds(re: f64) -> Result<f64, SimError> {
 /// cylinder (module docs).
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] for Re outside [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]] (or not
+/// [`SimError::OutOfRange`] for Re outside [`MIN_REYNOLDS`, `MAX_REYNOLDS`] (or not
 /// finite); [`SimError::OutOfRange`] naming `bessel` should the Bessel functions fail.
 pub fn gamma_circular(re: f64) -> Result<Complex<f64>, SimError> {
     let re = check_reynolds(re)?;
@@ -224,7 +224,7 @@ pub struct Section {
 
 impl Section {
     /// The section of a rectangular beam (its width, thickness and density).
-    pub fn of(beam: &Cantilever) -> Section {
+    pub(crate) fn of(beam: &Cantilever) -> Section {
         Section {
             width: beam.width,
             mass_per_length: beam.mass_per_length(),
@@ -248,10 +248,10 @@ impl Section {
 
     /// The mode of this section resonating at `frequency_hz` in `medium`: its quality factor
     /// Q = (1/T + Γ_r)/Γ_i and added mass TΓ_r at that frequency, and the vacuum frequency
-    /// f_vac = f √(1 + TΓ_r) it comes from (the inverse of [`wet_mode_of`], closed form).
+    /// f_vac = f √(1 + TΓ_r) it comes from (the inverse of `wet_mode_of`, closed form).
     ///
     /// # Errors
-    /// As [`wet_mode_of`].
+    /// As `wet_mode_of`.
     pub fn mode_at(&self, frequency_hz: f64, medium: &Medium) -> Result<(WetMode, f64), SimError> {
         self.validate()?;
         medium.validate()?;
@@ -273,7 +273,7 @@ impl Section {
 
 /// The mode of vacuum frequency `vacuum_frequency_hz` of the rectangular beam `beam` (its
 /// width, thickness and density) in `medium`: the wet frequency, quality factor and added mass
-/// (module docs). [`wet_mode_of`] of its [`Section`].
+/// (module docs). `wet_mode_of` of its [`Section`].
 ///
 /// # Errors
 /// [`SimError::Units`] naming the field for an invalid beam, medium or frequency;
@@ -293,7 +293,7 @@ pub fn wet_mode(
 /// # Errors
 /// [`SimError::Units`] naming the field for an invalid section, medium or frequency;
 /// [`SimError::OutOfRange`] naming `reynolds` when the wet mode's Re leaves Sader's range.
-pub fn wet_mode_of(
+pub(crate) fn wet_mode_of(
     vacuum_frequency_hz: f64,
     section: &Section,
     medium: &Medium,

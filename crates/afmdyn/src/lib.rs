@@ -38,6 +38,20 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! ## What is public
+//!
+//! * The front ends (the command line, Python, WebAssembly, `afmdyn-plot`) reach the library
+//!   through [`request`] (the requests, their names, defaults and limits, the one door that
+//!   admits and runs them), [`report`] (the result documents), [`layout`] (the result variables
+//!   and files), [`study`] (the stores that resume), [`probe`], [`cantilevers`], [`units`],
+//!   [`hydro`], [`io`] and [`error`].
+//! * The model and the algorithms — [`params`], [`model`], [`contact`], [`integrate`], [`maps`],
+//!   [`analysis`], [`trajectory`], [`system`], [`tip_sample`], [`beam`], [`galerkin`],
+//!   [`eigen`] and the re-exports below — are public for use as a library (the example above),
+//!   the integration tests, the examples and the benchmarks.
+//! * Everything else is `pub(crate)`: an item is public only when one of those names it or a
+//!   public item's signature shows it.
+//!
 //! ## Features
 //!
 //! All three are on by default; the command line and the Python module use them.
@@ -76,7 +90,7 @@ pub mod params;
 pub mod probe;
 pub mod report;
 pub mod request;
-pub mod roots;
+pub(crate) mod roots;
 pub mod study;
 pub mod system;
 pub mod tip_sample;

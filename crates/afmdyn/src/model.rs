@@ -19,7 +19,7 @@
 //! moves with the sample (V_T ≡ 0) under the constraint force λ = −m_eff V̈_T^free, the force that
 //! cancels the free tip acceleration relative to the sample; the tip leaves when λ falls to 0.
 //! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once the next bounce
-//! would rise less than [`STICK_HEIGHT_TOLERANCES`] guard tolerances while λ > 0.
+//! would rise less than `STICK_HEIGHT_TOLERANCES` guard tolerances while λ > 0.
 
 use crate::contact::{ContactLaw, PreparedLaw, TipSample, TipSampleLaw, Zener};
 use crate::error::{ParamError, SimError};
@@ -32,7 +32,7 @@ mod body_contact;
 mod rate_form;
 
 pub use body_contact::{weighted_displacement, BodyContactCheck};
-pub use rate_form::RateForm;
+pub(crate) use rate_form::RateForm;
 
 /// A chattering sequence ends in sticking when the next bounce would rise less than this many
 /// guard tolerances above the sample (1e3 × 1e-12 (1 + α2 + |α5|) ≈ 1e-9 of the gap g₀). The
@@ -41,7 +41,7 @@ pub use rate_form::RateForm;
 /// the round-off dead band of the event search. The impact velocities decay as rᵏ, so at most
 /// ln(h_stick/h₀)/(2 ln r) impacts precede the sticking, and the sticking starts at most
 /// 2 r v/(|V̈_T|(1 − r)) before the accumulation point of the unresolved impacts.
-pub const STICK_HEIGHT_TOLERANCES: f64 = 1e3;
+pub(crate) const STICK_HEIGHT_TOLERANCES: f64 = 1e3;
 
 /// Baumgarte rate of the sticking constraint, in units of Ω (see the sticking force λ).
 pub(crate) const BAUMGARTE_RATE: f64 = 10.0;
@@ -63,7 +63,7 @@ pub struct RegionDynamics {
 /// enters the forcing only (Ω, α2, α5: A_s does not depend on it), see
 /// [`CantileverModel::forcing_derivative`].
 #[derive(Debug, Clone, PartialEq)]
-pub struct ForcingDerivative {
+pub(crate) struct ForcingDerivative {
     /// ∂b_const/∂p, shape `[2N]`.
     pub b_const: DVector<f64>,
     /// ∂b_sin/∂p, shape `[2N]`.
@@ -77,7 +77,7 @@ pub struct ForcingDerivative {
 /// The free region's derivative in the lever's damping α3
 /// ([`CantileverModel::damping_derivative`]): ∂f/∂α3 = b′(τ) + (0, V ȧ).
 #[derive(Debug, Clone, PartialEq)]
-pub struct DampingDerivative {
+pub(crate) struct DampingDerivative {
     /// ∂b/∂α3 of the forcing (the base velocity's term of eq. 14), lifted to the state.
     pub forcing: ForcingDerivative,
     /// V = −M⁻¹ diag(s), shape N×N: the rate's derivative per unit of ȧ.
@@ -255,7 +255,7 @@ impl CantileverModel {
     /// the same operations, and V_T, read from the parameters), without assembling it again.
     ///
     /// # Errors
-    /// As [`CantileverModel::new`]: [`Params::validate_fields`] of the changed parameters (the
+    /// As [`CantileverModel::new`]: `Params::validate_fields` of the changed parameters (the
     /// drive's common period, [`Params::validate`]'s further check, does not depend on α5);
     /// the model is unchanged then.
     pub fn set_gap(&mut self, alpha5: f64) -> Result<(), ParamError> {
@@ -678,7 +678,7 @@ impl CantileverModel {
     /// surface, a ← a − V_T m_eff M⁻¹φ and, when V̇_T < 0, ȧ ← ȧ − V̇_T m_eff M⁻¹φ (the smallest
     /// change in the kinetic metric with V_T = 0, V̇_T ≥ 0), with its Jacobian (2N×2N). `None`
     /// for every other start and law.
-    pub fn start_projection(
+    pub(crate) fn start_projection(
         &self,
         tau: f64,
         z: &DVector<f64>,

@@ -7,11 +7,11 @@ use std::fmt;
 use std::str::FromStr;
 
 /// Largest number of Galerkin modes supported (the mode shapes are accurate to ~1e-13 up to i = 20).
-pub const MAX_MODES: usize = 20;
+pub(crate) const MAX_MODES: usize = 20;
 
 /// Largest state dimension 2N + m: [`MAX_MODES`] modes and the internal states of a law
 /// ([`crate::ContactLaw::internal_states`], at most 1).
-pub const MAX_STATE: usize = 2 * MAX_MODES + 1;
+pub(crate) const MAX_STATE: usize = 2 * MAX_MODES + 1;
 
 const _: () = assert!(
     MAX_MODES == 20,
@@ -22,17 +22,17 @@ const _: () = assert!(
 /// beyond 10⁴ beam masses its Cholesky factor (used by every integrator) loses too many digits.
 pub const ALPHA1_MAX: f64 = 1e4;
 /// Largest drive amplitude α2 and gap |α5|: displacements scale with them, and the integrators
-/// stop as diverged at a state norm of [`STATE_NORM_MAX`]; beyond 10⁶ products such as the
+/// stop as diverged at a state norm of `STATE_NORM_MAX`; beyond 10⁶ products such as the
 /// squared gap in the contact energy leave the range where the switching search is reliable.
 pub const DISPLACEMENT_MAX: f64 = 1e6;
 /// Largest damping coefficients α3 and α6: the damping rate sets the stiffness of the system,
-/// and the exact grid needs about α·T steps per drive period (see [`GRID_BUDGET_BYTES`]).
+/// and the exact grid needs about α·T steps per drive period (see `GRID_BUDGET_BYTES`).
 pub const DAMPING_MAX: f64 = 1e4;
 /// Largest contact stiffness α4: contact frequencies grow as √(4Nα4); beyond 10⁸ the contact
 /// system is both stiff and ill-conditioned.
 pub const ALPHA4_MAX: f64 = 1e8;
 /// Smallest drive frequency Ω: below it one drive period spans more than ~10⁴ oscillations of
-/// the first mode, a grid far beyond [`GRID_BUDGET_BYTES`] for any N > 1.
+/// the first mode, a grid far beyond `GRID_BUDGET_BYTES` for any N > 1.
 pub const OMEGA_MIN: f64 = 1e-3;
 /// Smallest modulation frequency Ω = f_m/f₀ of a moving sample ([`Excitation::Sample`],
 /// off-resonance tapping): f₀/f_m up to 10⁵ is physical (a 300 kHz lever under a 1–8 kHz
@@ -48,16 +48,16 @@ pub(crate) const OMEGA_MIN_MODULATED: f64 = 1e-5;
 pub const OMEGA_MAX: f64 = 1e5;
 /// States with ‖z‖₂ at or above this are treated as diverged by the integrators; an initial
 /// state must lie below it.
-pub const STATE_NORM_MAX: f64 = 1e12;
+pub(crate) const STATE_NORM_MAX: f64 = 1e12;
 /// Memory budget of the exact propagator's period grid: (2N + 2)(m + 1) values of 8 bytes for
 /// m sub-steps per drive period. A parameter set whose grid would exceed it is refused before
 /// anything is allocated (Ω very small, or very stiff or heavily damped contact).
-pub const GRID_BUDGET_BYTES: f64 = 128.0 * 1024.0 * 1024.0;
+pub(crate) const GRID_BUDGET_BYTES: f64 = 128.0 * 1024.0 * 1024.0;
 /// Budget of the adaptive oracle: the estimated number of steps per drive period, T‖A‖_F (the
 /// Frobenius norm bounds the fastest rate of the system), may not exceed this.
-pub const ADAPTIVE_STEPS_BUDGET: f64 = 1e7;
+pub(crate) const ADAPTIVE_STEPS_BUDGET: f64 = 1e7;
 /// Budget of the adaptive integrator while it runs: the DOP853 steps (accepted and rejected)
-/// it may take within one drive period. The estimate of [`ADAPTIVE_STEPS_BUDGET`] sees the
+/// it may take within one drive period. The estimate of `ADAPTIVE_STEPS_BUDGET` sees the
 /// linear part only; a nonlinear law can grow far stiffer where the motion goes (a tip captured
 /// by a strong DMT adhesion needs ~3e5 steps per period, ~2 s, where the default Hertz orbit
 /// needs ~200). 1e5 steps (~1 s at N = 3) is 500× the default's; beyond, the run ends with
@@ -251,19 +251,19 @@ fn bounded(
 pub(crate) const MAX_DRIVE_COMPONENTS: usize = 3;
 /// Largest common period of a multifrequency drive, in periods 2π/Ω of the primary drive:
 /// the orbit, the stroboscopic map and the observables' window span this many periods.
-pub const MAX_COMMON_PERIODS: u64 = 1000;
+pub(crate) const MAX_COMMON_PERIODS: u64 = 1000;
 /// Largest q of a component's ratio p/q: with q up to 10⁶ every frequency ratio is given to
 /// about 1e-12 (a continued fraction's convergent), so an incommensurate ratio is represented
 /// to round-off of a window's phase; such a drive is quasi-periodic ([`Params::is_quasiperiodic`]).
-pub const MAX_RATIO_DENOMINATOR: u32 = 1_000_000;
+pub(crate) const MAX_RATIO_DENOMINATOR: u32 = 1_000_000;
 /// Largest p of a component's ratio p/q.
-pub const MAX_RATIO_NUMERATOR: u32 = 1_000_000_000;
+pub(crate) const MAX_RATIO_NUMERATOR: u32 = 1_000_000_000;
 
 /// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤ `max_q` (and
 /// p ≤ [`MAX_RATIO_NUMERATOR`]), as [`crate::probe::convergent`]: the best rational
 /// approximation of `r` with a denominator that small. `None` for r outside (0, 10⁶) or not
 /// finite.
-pub fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
+pub(crate) fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
     if !(r.is_finite() && r > 0.0 && r < 1e6) {
         return None;
     }
@@ -308,14 +308,14 @@ fn no_components(c: &[Option<DriveComponent>; 3]) -> bool {
 /// at the tip (magnetic or photothermal) beside the base drive, which does not move V_T.
 /// The frequency ratio p/q is rational, so the drive is periodic with the common period
 /// 2πq/Ω for p/q in lowest terms ([`Params::common_periods`]); a common period beyond
-/// [`MAX_COMMON_PERIODS`] makes the drive quasi-periodic ([`Params::is_quasiperiodic`]).
+/// `MAX_COMMON_PERIODS` makes the drive quasi-periodic ([`Params::is_quasiperiodic`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DriveComponent {
     /// F̃ ≥ 0, the force amplitude at the tip (model units, above).
     pub force: f64,
-    /// [p, q], p in 1..=[`MAX_RATIO_NUMERATOR`] and q in 1..=[`MAX_RATIO_DENOMINATOR`]: the
+    /// [p, q], p in 1..=`MAX_RATIO_NUMERATOR` and q in 1..=`MAX_RATIO_DENOMINATOR`: the
     /// frequency is p/q times Ω (q sets the common period, [`Params::common_periods`]; above
-    /// [`MAX_COMMON_PERIODS`] the drive is quasi-periodic).
+    /// `MAX_COMMON_PERIODS` the drive is quasi-periodic).
     pub ratio: [u32; 2],
     /// θ, the phase of the component (rad).
     pub phase: f64,
@@ -377,7 +377,7 @@ impl Params {
     }
 
     /// Check every field against its allowed range, and that the drive is periodic with a
-    /// common period of at most [`MAX_COMMON_PERIODS`] drive periods (what periodic orbits,
+    /// common period of at most `MAX_COMMON_PERIODS` drive periods (what periodic orbits,
     /// stroboscopic maps and every analysis but the time average need).
     ///
     /// # Errors
@@ -395,7 +395,7 @@ impl Params {
         Ok(())
     }
 
-    /// Whether the drive's common period exceeds [`MAX_COMMON_PERIODS`]: a ratio p/q given to
+    /// Whether the drive's common period exceeds `MAX_COMMON_PERIODS`: a ratio p/q given to
     /// within 1e-12 by a q up to 10⁶, incommensurate in all but name, whose response is
     /// measured by the time average ([`crate::analysis::stepped::average`]).
     pub fn is_quasiperiodic(&self) -> bool {
@@ -407,7 +407,7 @@ impl Params {
     ///
     /// # Errors
     /// [`ParamError`] naming the first field out of range.
-    pub fn validate_fields(&self) -> Result<(), ParamError> {
+    pub(crate) fn validate_fields(&self) -> Result<(), ParamError> {
         self.validate_groups()?;
         self.contact_law.validate()?;
         // the law's groups against the shared α4, α6 (JKR's neck scale P̃/α4, the SLS
@@ -626,7 +626,7 @@ impl Params {
 
     /// Amplitude of the base displacement in V_T (eq. 8): α2 for the base-driven beam and for a
     /// moving sample ([`Excitation::Sample`], any structure: the tip–sample distance carries
-    /// the same sinusoid), 0 for a force drive ([`Params::is_force_driven`]: the lumped models,
+    /// the same sinusoid), 0 for a force drive (`Params::is_force_driven`: the lumped models,
     /// the beam with [`Excitation::Tip`]), whose base does not move. Every V_T formula uses this.
     pub fn base_amplitude(&self) -> f64 {
         if self.is_force_driven() {
@@ -638,7 +638,7 @@ impl Params {
 
     /// Whether the primary drive is a force at the tip: the lumped models, and the beam with
     /// [`Excitation::Tip`] (never with [`Excitation::Sample`]).
-    pub fn is_force_driven(&self) -> bool {
+    pub(crate) fn is_force_driven(&self) -> bool {
         self.excitation != Excitation::Sample
             && (self.structure.is_lumped() || self.excitation == Excitation::Tip)
     }
@@ -705,7 +705,7 @@ impl Params {
     }
 
     /// Σ F̃_i cos(p_i/q_i Ω τ + θ_i), the further components' tip force at τ (0 without them).
-    pub fn component_force(&self, tau: f64) -> f64 {
+    pub(crate) fn component_force(&self, tau: f64) -> f64 {
         self.components()
             .map(|c| c.force * (c.ratio() * self.omega * tau + c.phase).cos())
             .sum()

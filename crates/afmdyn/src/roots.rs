@@ -9,7 +9,7 @@
 /// Zero of g on [lo, hi] given g(lo) > 0 ≥ g(hi); `g(t)` returns (g, g′). `offset` is added to
 /// t for the relative stopping test (pass the step's start time when t is local), so the result
 /// is exact to a few ulps of the absolute time.
-pub fn safeguarded_newton(
+pub(crate) fn safeguarded_newton(
     mut lo: f64,
     glo: f64,
     mut hi: f64,
@@ -70,7 +70,7 @@ pub fn safeguarded_newton(
 
 /// Zero of the derivative f′ of a dense quantity on [a, b], given f′(a) = `fa_d` and f′(b) of
 /// opposite signs (a local extremum of f); `f(τ)` returns (f, f′, f″).
-pub fn extremum(a: f64, b: f64, fa_d: f64, f: &mut dyn FnMut(f64) -> [f64; 3]) -> f64 {
+pub(crate) fn extremum(a: f64, b: f64, fa_d: f64, f: &mut dyn FnMut(f64) -> [f64; 3]) -> f64 {
     let sign = if fa_d > 0.0 { 1.0 } else { -1.0 };
     let [_, db, _] = f(b);
     safeguarded_newton(a, sign * fa_d, b, sign * db, 0.0, &mut |t| {

@@ -190,7 +190,11 @@ pub trait HybridSystem: Send + Sync {
 /// # Errors
 /// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`], naming
 /// `name`.
-pub fn check_state(name: &'static str, dim: usize, z: &DVector<f64>) -> Result<(), SimError> {
+pub(crate) fn check_state(
+    name: &'static str,
+    dim: usize,
+    z: &DVector<f64>,
+) -> Result<(), SimError> {
     if z.len() != dim {
         return Err(SimError::StateLength {
             name,
@@ -262,7 +266,7 @@ pub fn saltation<S: HybridSystem + ?Sized>(
 /// w (∂g/∂p) δp: the sensitivity s = ∂z/∂p crosses the event as s⁺ = S s⁻ + w ∂g/∂p (the
 /// parameter column of the saltation matrix of the system extended by ṗ = 0; Leine &
 /// Nijmeijer 2004, §7.1, with p as a state).
-pub fn saltation_with_shift<S: HybridSystem + ?Sized>(
+pub(crate) fn saltation_with_shift<S: HybridSystem + ?Sized>(
     sys: &S,
     from: Region,
     tau: f64,
@@ -283,7 +287,7 @@ pub struct SaltationParts {
     pub jump: Jump,
     /// ∇_z g of the guard left, shape `[d]`.
     pub grad: DVector<f64>,
-    /// The event shift w of [`saltation_with_shift`], shape `[d]`.
+    /// The event shift w of `saltation_with_shift`, shape `[d]`.
     pub shift: DVector<f64>,
 }
 
@@ -309,7 +313,7 @@ impl SaltationParts {
 }
 
 /// The parts R, ∇_z g and w of the saltation matrix of the event of mode `from` at (τ, z⁻)
-/// (module docs; w as in [`saltation_with_shift`], zero when ġ = 0).
+/// (module docs; w as in `saltation_with_shift`, zero when ġ = 0).
 pub fn saltation_parts<S: HybridSystem + ?Sized>(
     sys: &S,
     from: Region,

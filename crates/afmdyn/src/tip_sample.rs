@@ -58,7 +58,7 @@ pub trait TipSampleSystem: HybridSystem {
         Region::of_v_t(self.v_t(tau, z))
     }
     /// Check a state: length 2N, finite entries, ‖z‖ below the integrators' divergence
-    /// threshold [`crate::params::STATE_NORM_MAX`] ([`crate::system::check_state`]).
+    /// threshold `crate::params::STATE_NORM_MAX` (`crate::system::check_state`).
     ///
     /// # Errors
     /// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`], naming
@@ -68,7 +68,7 @@ pub trait TipSampleSystem: HybridSystem {
     }
     /// A start (τ, z) the system moves to before integrating, with its Jacobian (2N×2N), or
     /// `None` to start at z (the default). The cantilever with the impact law brings a start
-    /// inside the rigid sample to its surface ([`CantileverModel::start_projection`]).
+    /// inside the rigid sample to its surface (`CantileverModel::start_projection`).
     fn start_projection(&self, tau: f64, z: &DVector<f64>) -> Option<(DVector<f64>, DMatrix<f64>)> {
         let _ = (tau, z);
         None

@@ -1,8 +1,9 @@
 //! Trajectories: sampled time series, switching events, the stroboscopic Poincaré section,
-//! per-period energy bookkeeping and the body-contact check; [`chunked`]: a long run recorded in
+//! per-period energy bookkeeping and the body-contact check; `chunked`: a long run recorded in
 //! chunks of whole periods.
 
-pub mod chunked;
+#[cfg(feature = "files")]
+pub(crate) mod chunked;
 
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
@@ -150,7 +151,7 @@ pub struct Trajectory {
 /// values per sample: τ, V_T, W(1,τ), ∂W(1,τ)/∂τ, in contact (1) or not (0), F_c, a_1..a_N,
 /// ȧ_1..ȧ_N — the columns of `afmdyn simulate`'s time series, with no allocation per sample.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct SampleRows {
+pub(crate) struct SampleRows {
     width: usize,
     data: Vec<f64>,
 }
@@ -160,7 +161,7 @@ impl SampleRows {
     pub(crate) const LEADING: usize = 6;
 
     /// Empty rows for states of `dim` = 2N values.
-    pub fn new(dim: usize) -> Self {
+    pub(crate) fn new(dim: usize) -> Self {
         SampleRows {
             width: Self::LEADING + dim,
             data: Vec::new(),
@@ -168,32 +169,29 @@ impl SampleRows {
     }
 
     /// Values per row, 6 + 2N.
-    pub fn width(&self) -> usize {
+    #[cfg(feature = "files")]
+    pub(crate) fn width(&self) -> usize {
         self.width
     }
 
     /// Number of samples.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.data.len().checked_div(self.width).unwrap_or(0)
     }
 
-    /// Whether there is no sample.
-    pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
-    }
-
     /// All rows, one after the other.
-    pub fn as_slice(&self) -> &[f64] {
+    #[cfg(feature = "files")]
+    pub(crate) fn as_slice(&self) -> &[f64] {
         &self.data
     }
 
     /// Row `i`.
-    pub fn row(&self, i: usize) -> &[f64] {
+    pub(crate) fn row(&self, i: usize) -> &[f64] {
         &self.data[i * self.width..(i + 1) * self.width]
     }
 
     /// Sample `i` as a [`Sample`].
-    pub fn sample(&self, i: usize) -> Sample {
+    pub(crate) fn sample(&self, i: usize) -> Sample {
         Sample::from_row(self.row(i))
     }
 
@@ -317,7 +315,7 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
 ///
 /// # Errors
 /// As [`record`].
-pub fn record_rows(
+pub(crate) fn record_rows(
     integ: &mut dyn Integrator,
     spec: &RecordSpec,
     rows: &mut SampleRows,

@@ -99,7 +99,7 @@ pub(crate) fn preset<T: Copy>(
 }
 
 /// Hertz contact stiffness K₁ = 2E*√(RΔ) (paper §4), E* of tip and sample
-/// ([`crate::contact::reduced_modulus`]). N/m.
+/// (`crate::contact::reduced_modulus`). N/m.
 pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
     let (t, s) = (tip, sample);
     let e_star = crate::contact::reduced_modulus(
@@ -145,7 +145,7 @@ impl Cantilever {
         Ok(())
     }
     /// Second moment of area I = b h³ / 12 (m⁴).
-    pub fn inertia(&self) -> f64 {
+    pub(crate) fn inertia(&self) -> f64 {
         self.width * self.thickness.powi(3) / 12.0
     }
     /// Bending stiffness EI (N m²).
@@ -355,15 +355,6 @@ impl PhysicalModel {
             bare_first_frequency_hz: bare,
         }
     }
-}
-
-/// Beam damping given directly (C, N s/m²) or through the first-mode quality factor Q₁.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum BeamDamping {
-    /// C in N s/m².
-    Coefficient(f64),
-    /// Q₁ of the first free mode (with the tip mass).
-    QualityFactor(f64),
 }
 
 /// Contact stiffness given directly (N/m) or by the Hertz model.

@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Samples per drive period of the lock-in's demodulation.
-pub const LOCK_IN_SAMPLES: usize = 32;
+pub(crate) const LOCK_IN_SAMPLES: usize = 32;
 
 /// The feedback's gains and the lock-in's time constant (model units: τ, g₀).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -119,7 +119,7 @@ impl LockIn {
 /// sampled `samples` times (module docs), the integrator advanced to the period's end.
 ///
 /// The samples are read from the integrator's dense output inside the steps it takes over the
-/// period ([`sample_dense`]), so that they do not cut its steps: (A, φ) differ from
+/// period (`sample_dense`), so that they do not cut its steps: (A, φ) differ from
 /// [`demodulate_period_stepped`]'s by about the tolerance times the amplitude (the test
 /// `dense_and_stepped_demodulation_agree`). An integrator with spans ([`Integrator::spans`]:
 /// the exact propagator, the split integrator) is stepped to each sample as
@@ -259,7 +259,7 @@ pub struct ScanPixel {
 
 /// What a scan line needs (model units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LineSpec {
+pub(crate) struct LineSpec {
     /// The materials under the tip: the same lever and drive, only the sample differs (their
     /// α5 is set per period).
     pub materials: Vec<Params>,
@@ -287,7 +287,7 @@ pub struct LineSpec {
 
 /// Where a line engages: far above its first pixel's material, on the steady state there.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Engage {
+pub(crate) struct Engage {
     /// The steady state at the start (τ = 0 of a period), shape `[dim]` of its material.
     pub state: DVector<f64>,
     /// Its rest distance z_c (g₀).
@@ -414,7 +414,7 @@ pub(crate) fn engage_position(spec: &LineSpec) -> f64 {
 /// [`SimError::OutOfRange`] naming `periods_per_pixel`, `samples` or `materials` when 0;
 /// [`SimError::Cancelled`] once `cancel` is set; `material` when `under_tip` names none of
 /// `spec.materials`; the model's and the integrator's errors.
-pub fn scan_line(
+pub(crate) fn scan_line(
     spec: &LineSpec,
     engage: &Engage,
     under_tip: &dyn Fn(f64) -> (usize, f64),

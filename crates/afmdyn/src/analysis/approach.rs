@@ -17,7 +17,7 @@ use crate::params::{Params, SweepParam};
 /// threshold, A₀ the free amplitude of `base` ([`free_response`]; under a multifrequency drive
 /// the sum of the components' free amplitudes), where the sample is out of reach, down to
 /// 0.1 A₀ above it — deep in the repulsive regime of a stiff sample — or, on a soft sample,
-/// to 0.4 A₀ − δ_k ([`soft_indentation`]): a rigid sample holds the amplitude at A/A₀ = 0.5
+/// to 0.4 A₀ − δ_k (`soft_indentation`): a rigid sample holds the amplitude at A/A₀ = 0.5
 /// near z_c = 0.5 A₀, and a compliant one lets the tip sink by about the indentation δ_k at
 /// which it pushes back with the peak force of tapping at that setpoint, so the curve reaches
 /// A/A₀ ≤ 0.5 (issue 60 item 12: a 0.09 N/m lever on 1 MPa in water never got below
@@ -50,7 +50,7 @@ pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
 /// eigenmode model), Q₁ = 1/(2ζ₁) of its first damped free mode. At most 3 A₀ (a sample that
 /// never pushes back so hard gives that bound; a rigid one, whose law has no force of its
 /// own, 0).
-pub fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
+pub(crate) fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
     use crate::contact::{TipSample, TipSampleLaw};
     use crate::galerkin::Region;
     let p = model.params();

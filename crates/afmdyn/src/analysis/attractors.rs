@@ -87,7 +87,7 @@ pub struct Attractor {
     /// Newton's method did not converge).
     pub orbit: Option<PeriodicOrbit>,
     /// The largest Lyapunov exponent λ₁ (per unit τ) of a nonperiodic motion and its error,
-    /// over [`CENSUS_LYAPUNOV_PERIODS`] drive periods from its last section point (`None` for
+    /// over `CENSUS_LYAPUNOV_PERIODS` drive periods from its last section point (`None` for
     /// a periodic one, or when the estimate failed).
     pub lyapunov: Option<(f64, f64)>,
 }
@@ -103,7 +103,7 @@ impl Attractor {
 
 /// Drive periods of the λ₁ estimate of a census's nonperiodic ends: a basin map's
 /// (as the basin map's, [`super::basins::LYAPUNOV_PERIODS`], and a chart's default).
-pub const CENSUS_LYAPUNOV_PERIODS: usize = 500;
+pub(crate) const CENSUS_LYAPUNOV_PERIODS: usize = 500;
 
 /// The result of an attractor search.
 #[derive(Debug, Clone, PartialEq)]

@@ -87,7 +87,7 @@ pub fn basin_entropy(labels: &[i64], nx: usize, n: usize) -> Option<BasinEntropy
 /// The uncertainty exponent α of the `labels` (row-major, `nx` per row) and the fractions
 /// f(ε) it was fitted to, for ε = 1, 2, 4, … cells up to a quarter of the smaller side. `None`
 /// when fewer than two ε fit, or no cell is uncertain at some ε (a map of one label: f = 0).
-pub fn uncertainty_exponent(labels: &[i64], nx: usize) -> Option<(f64, Vec<(usize, f64)>)> {
+pub(crate) fn uncertainty_exponent(labels: &[i64], nx: usize) -> Option<(f64, Vec<(usize, f64)>)> {
     if nx == 0 || !labels.len().is_multiple_of(nx) {
         return None;
     }

@@ -4,7 +4,7 @@
 //!
 //! A start iterates the stroboscopic map P (one drive period) and stops as soon as
 //!
-//! 1. **near**: [`NEAR_HITS`] consecutive returns lie within `near_tol` (relative to 1 + |p|)
+//! 1. **near**: `NEAR_HITS` consecutive returns lie within `near_tol` (relative to 1 + |p|)
 //!    of the section points of one known *periodic* attractor — a stable orbit's neighbourhood,
 //!    where the trajectory converges to it; or
 //! 2. **recurrence**: `basin_hits` consecutive returns fall in cells of the state space
@@ -55,7 +55,7 @@ mod rows;
 use rows::{coarse_grid, coarse_indices, merge_pass, run_row, strides, CoarseGrid};
 
 /// Consecutive returns near a known periodic attractor that decide a start.
-pub const NEAR_HITS: usize = 3;
+pub(crate) const NEAR_HITS: usize = 3;
 /// Default relative distance that counts as near a periodic attractor's section point.
 pub const DEFAULT_NEAR_TOL: f64 = 0.02;
 /// Default side of the recurrence test's state-space cells (g0).
@@ -74,7 +74,7 @@ pub const DEFAULT_STRIDE: usize = 0;
 /// Fewest nodes per axis of the first pass's coarse grid chosen automatically. (On the impact
 /// oscillator N = 1, r = 0.8, Ω = 2 at 100 × 100, a first grid of 13 × 13 (stride 8) held no
 /// node in the 8 % basin, and 7 % of the labels were wrong; 25 × 25 (stride 4): 99.7 % right.)
-pub const MIN_COARSE_NODES: usize = 25;
+pub(crate) const MIN_COARSE_NODES: usize = 25;
 
 /// A coordinate of the initial state: modal `a_j`, `ȧ_j` (j from 1), or the tip deflection
 /// W(1,0) and velocity (set through mode 1, the other modes as the base state has them).
@@ -128,7 +128,7 @@ impl fmt::Display for StateCoord {
 
 impl StateCoord {
     /// Whether the coordinate exists for N modes.
-    pub fn fits(self, modes: usize) -> bool {
+    pub(crate) fn fits(self, modes: usize) -> bool {
         match self {
             StateCoord::A(j) | StateCoord::ADot(j) => (1..=modes).contains(&j),
             _ => true,
@@ -268,7 +268,7 @@ impl BasinSpec {
     }
 
     /// The stride of the first pass: `stride`, or when 0 the largest power of two that leaves
-    /// the coarse grid at least [`MIN_COARSE_NODES`] nodes per axis (1 for a map of fewer).
+    /// the coarse grid at least `MIN_COARSE_NODES` nodes per axis (1 for a map of fewer).
     pub fn first_stride(&self) -> usize {
         if self.stride > 0 {
             return self.stride;
@@ -282,7 +282,7 @@ impl BasinSpec {
     }
 
     /// The value of a coordinate of the state `z` (to place a section point on the map).
-    pub fn coordinate(model: &CantileverModel, c: StateCoord, z: &DVector<f64>) -> f64 {
+    pub(crate) fn coordinate(model: &CantileverModel, c: StateCoord, z: &DVector<f64>) -> f64 {
         let n = model.modes();
         match c {
             StateCoord::A(j) => z[j - 1],
@@ -312,7 +312,7 @@ pub enum Decided {
 
 impl Decided {
     /// Every decision, in the order of their codes 1, 2, ….
-    pub const ALL: [Decided; 5] = [
+    pub(crate) const ALL: [Decided; 5] = [
         Decided::Near,
         Decided::Recurrence,
         Decided::Grid,
@@ -320,7 +320,7 @@ impl Decided {
         Decided::Failed,
     ];
 
-    /// The decision's code in `basins.nc`: its place in [`Self::ALL`], from 1.
+    /// The decision's code in `basins.nc`: its place in `Self::ALL`, from 1.
     pub fn code(self) -> i32 {
         Self::ALL
             .iter()
@@ -364,12 +364,12 @@ pub struct BasinMap {
     /// `None` for a nonperiodic one or where shooting failed.
     pub orbits: Vec<Option<PeriodicOrbit>>,
     /// Each nonperiodic attractor's largest Lyapunov exponent λ₁ (per unit τ, over
-    /// [`LYAPUNOV_PERIODS`] drive periods); `None` for a periodic one or a failed run.
+    /// `LYAPUNOV_PERIODS` drive periods); `None` for a periodic one or a failed run.
     pub lyapunov: Vec<Option<f64>>,
 }
 
 /// Drive periods of the λ₁ estimate of a nonperiodic attractor of a basin map.
-pub const LYAPUNOV_PERIODS: usize = super::attractors::CENSUS_LYAPUNOV_PERIODS;
+pub(crate) const LYAPUNOV_PERIODS: usize = super::attractors::CENSUS_LYAPUNOV_PERIODS;
 
 impl BasinMap {
     /// The labels, row-major.
@@ -379,7 +379,7 @@ impl BasinMap {
 
     /// The basin fraction of each attractor: its share of all cells (failed cells included in
     /// the total, so the fractions add up to 1 less the failed share).
-    pub fn basin_fractions(&self) -> Vec<f64> {
+    pub(crate) fn basin_fractions(&self) -> Vec<f64> {
         let n = self.cells.len().max(1) as f64;
         (0..self.attractors.len())
             .map(|i| self.cells.iter().filter(|c| c.label == i as i64).count() as f64 / n)
@@ -416,7 +416,7 @@ type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
 /// and the rows it runs — what each row of the pass needs, and all of it (a row is a pure
 /// function of it: any executor gives the same map).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PassStart {
+pub(crate) struct PassStart {
     /// The pass (0 the coarsest).
     pub pass: usize,
     /// The attractors found by the passes before.
@@ -428,7 +428,7 @@ pub struct PassStart {
 }
 
 /// The number of passes of `spec` (one where the plane is not the whole section).
-pub fn passes(spec: &BasinSpec) -> usize {
+pub(crate) fn passes(spec: &BasinSpec) -> usize {
     strides(spec).len()
 }
 
@@ -436,7 +436,7 @@ pub fn passes(spec: &BasinSpec) -> usize {
 /// later passes are ignored, those of this pass are not run again): the passes before merged
 /// in their order — the merge of [`basin_map`] —, the last one's coarse grid, and the rows
 /// left to run.
-pub fn pass_start(spec: &BasinSpec, rows: &[BasinRow], pass: usize) -> PassStart {
+pub(crate) fn pass_start(spec: &BasinSpec, rows: &[BasinRow], pass: usize) -> PassStart {
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
     let strides = strides(spec);
     let (attractors, slots) = merge_passes(spec, rows.iter().filter(|r| r.pass < pass).cloned());
@@ -497,7 +497,7 @@ pub(crate) fn run_pass_row(
 
 /// Run every pass of `spec` (rows in parallel on the current rayon pool), showing each finished
 /// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
-/// grid of the ones before it ([`pass_start`]). The rows in `stored` (a resumed run's, as
+/// grid of the ones before it (`pass_start`). The rows in `stored` (a resumed run's, as
 /// `sink` saw them) are not run again but merged in their place, so a resumed run makes the
 /// map an uninterrupted one makes. Stops starting rows once `cancel` is set. Returns every
 /// row, `stored` first, from which [`basin_map`] makes the map.

@@ -241,7 +241,8 @@ impl Seeds {
     /// The seeds from the coarse passes' results ([`SweepPlan::coarse`] of the forward and
     /// the backward branch), as an executor that runs the passes as tasks of its own
     /// assembles them.
-    pub fn new(forward: Vec<DVector<f64>>, backward: Vec<DVector<f64>>) -> Seeds {
+    #[cfg(feature = "files")]
+    pub(crate) fn new(forward: Vec<DVector<f64>>, backward: Vec<DVector<f64>>) -> Seeds {
         Seeds { forward, backward }
     }
 
@@ -330,7 +331,7 @@ impl<'a> SweepPlan<'a> {
     /// The coarse pass of `branch` (stage 0): continuation over the first value of each chunk
     /// from rest; returns the seed of every chunk. Stops early (with rest for the chunks not
     /// reached) once `cancel` is set.
-    pub fn coarse(&self, branch: Branch, cancel: &AtomicBool) -> Vec<DVector<f64>> {
+    pub(crate) fn coarse(&self, branch: Branch, cancel: &AtomicBool) -> Vec<DVector<f64>> {
         let dim = self.spec.base.state_dim();
         let mut z = DVector::zeros(dim);
         let mut seeds = vec![DVector::zeros(dim); self.chunks()];
@@ -354,7 +355,7 @@ impl<'a> SweepPlan<'a> {
     /// The seeds of every chunk (both coarse passes, in parallel), computed only where a
     /// chunk after the first still needs its seed (a resumed sweep whose chunks have all
     /// started needs none).
-    pub fn seeds(&self, resume: &Resume, cancel: &AtomicBool) -> Seeds {
+    pub(crate) fn seeds(&self, resume: &Resume, cancel: &AtomicBool) -> Seeds {
         let needs = |b: Branch| {
             (1..self.chunks()).any(|k| {
                 self.chunk_indices(b, k)
@@ -380,7 +381,7 @@ impl<'a> SweepPlan<'a> {
 
     /// Run one stage-1 task: each of its points not in `resume` goes to `sink` as soon as it
     /// is finished. A chain segment goes on from the stored state of its done points. A
-    /// coarse task does nothing here (see [`SweepPlan::coarse`]).
+    /// coarse task does nothing here (see `SweepPlan::coarse`).
     pub fn run_task(
         &self,
         task: SweepTask,

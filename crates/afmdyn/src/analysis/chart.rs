@@ -6,7 +6,7 @@
 //! A chart is planned as independent tasks ([`ChartPlan`]): a task is a *tile*, up to
 //! [`ChartSpec::tile`] consecutive cells of one row (one y value). In a tile each cell gets
 //!
-//! 1. its K random starts ([`cell_start`], keyed by the seed and the cell's x and y, never by
+//! 1. its K random starts (`cell_start`, keyed by the seed and the cell's x and y, never by
 //!    execution order), and
 //! 2. continuation from its neighbours along x: a forward pass seeds each cell with the
 //!    attractors of the cell to its left, a backward pass with those of the cell to its right
@@ -185,7 +185,13 @@ pub struct ChartCell {
 
 /// The random initial state of start `k` of the cell at (x, y), keyed by the seed and the
 /// cell's coordinates (the same cell gets the same starts in every chart that contains it).
-pub fn cell_start(model: &CantileverModel, seed: u64, x: f64, y: f64, k: u32) -> DVector<f64> {
+pub(crate) fn cell_start(
+    model: &CantileverModel,
+    seed: u64,
+    x: f64,
+    y: f64,
+    k: u32,
+) -> DVector<f64> {
     let key = mix64(x.to_bits()) ^ mix64(y.to_bits()).rotate_left(17) ^ u64::from(k);
     random_state(model, seed, key)
 }

@@ -32,7 +32,7 @@ pub struct ConvergenceRun {
 /// # Errors
 /// [`SimError`] for invalid parameters or a failing run; [`SimError::Cancelled`] once
 /// `progress` is cancelled.
-pub fn mode_convergence(
+pub(crate) fn mode_convergence(
     params: &Params,
     max_modes: usize,
     periods: usize,

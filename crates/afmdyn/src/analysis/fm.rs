@@ -15,7 +15,7 @@
 //!
 //! with A₁ and φ₁ the first-harmonic amplitude and lag of the tip deflection behind the drive
 //! ([`super::observables`], its conventions) and φ_set the lag of the free linear response at
-//! the natural frequency ω_K of the tracked mode K ([`super::resonance::mode_resonance`];
+//! the natural frequency ω_K of the tracked mode K (`super::resonance::mode_resonance`;
 //! [`FmReference`]). The orbit is found by Newton shooting on the stroboscopic map at each
 //! (Ω, α2) ([`super::shooting`]), and (Ω, α2) by Newton's method on the two conditions, its
 //! 2×2 Jacobian by forward differences and then Broyden's secant update (Broyden, *Math.
@@ -63,18 +63,18 @@ mod solver;
 use solver::{predict, Locked, Solver};
 
 /// Default tolerance of the two loop conditions: |A₁/A − 1| and |φ₁ − φ_set| (rad).
-pub const DEFAULT_LOOP_TOLERANCE: f64 = 1e-9;
+pub(crate) const DEFAULT_LOOP_TOLERANCE: f64 = 1e-9;
 /// Default tolerance of the integrator of the orbits ([`FmSpec::new`]).
-pub const DEFAULT_ORBIT_TOLERANCE: f64 = 1e-13;
+pub(crate) const DEFAULT_ORBIT_TOLERANCE: f64 = 1e-13;
 /// The loop conditions are met to the tolerance, or, where the orbit's own error bounds them
 /// (module docs, [`FmSpec::new`]), to this many times Q_K × the integrator's tolerance once
 /// Newton stops gaining.
 pub(crate) const NOISE_FLOOR_FACTOR: f64 = 1e3;
 /// A shooting that stops above its tolerance at a residual r ≤ [`ROUND_OFF_LIMIT`] (the map's
 /// round-off floor) is taken again to this many times r.
-pub const ROUND_OFF_RETRY: f64 = 4.0;
+pub(crate) const ROUND_OFF_RETRY: f64 = 4.0;
 /// The largest fixed-point residual taken as the map's round-off.
-pub const ROUND_OFF_LIMIT: f64 = 1e-7;
+pub(crate) const ROUND_OFF_LIMIT: f64 = 1e-7;
 /// … plus this many times Q_K × the orbit's fixed-point residual (an orbit error δz moves
 /// the first harmonic by up to Q δz/π).
 pub(crate) const ORBIT_FLOOR_FACTOR: f64 = 10.0;
@@ -114,10 +114,10 @@ pub struct FmSpec {
 }
 
 impl FmSpec {
-    /// Defaults: mode 1, tolerance [`DEFAULT_LOOP_TOLERANCE`], the integrator's tolerance
-    /// [`DEFAULT_ORBIT_TOLERANCE`], shooting to 1e-12 in at most 20 Newton
+    /// Defaults: mode 1, tolerance `DEFAULT_LOOP_TOLERANCE`, the integrator's tolerance
+    /// `DEFAULT_ORBIT_TOLERANCE`, shooting to 1e-12 in at most 20 Newton
     /// iterations, or, where the map's round-off is above that (a viscous √δ δ̇ contact: near
-    /// 1e-10), to [`ROUND_OFF_RETRY`] × the residual reached
+    /// 1e-10), to `ROUND_OFF_RETRY` × the residual reached
     ///
     /// The orbit must be tighter than an AM curve's: near resonance the fixed point of the
     /// stroboscopic map amplifies an error ε of the map by ‖(I − M)⁻¹‖ ≈ Q/π, and the phase
@@ -190,7 +190,11 @@ pub struct FmReference {
 ///
 /// # Errors
 /// As [`mode_resonance`] and [`free_response`].
-pub fn fm_reference(base: &Params, mode: usize, amplitude: f64) -> Result<FmReference, SimError> {
+pub(crate) fn fm_reference(
+    base: &Params,
+    mode: usize,
+    amplitude: f64,
+) -> Result<FmReference, SimError> {
     let (omega, q) = mode_resonance(base, mode)?;
     let at = base.with(SweepParam::Omega, omega);
     let model = CantileverModel::new(&at)?;
@@ -460,7 +464,7 @@ fn folds(solver: &Solver, points: &[FmPoint]) -> Result<Vec<FmFold>, SimError> {
 
 /// The lag error φ₁ − φ_set wrapped into (−π, π] (the lags are reported in (−π/2, 3π/2]: a
 /// higher mode's free lag, near 270°, sits at the wrap).
-pub fn phase_error(phase: f64, set: f64) -> f64 {
+pub(crate) fn phase_error(phase: f64, set: f64) -> f64 {
     let e = (phase - set).rem_euclid(std::f64::consts::TAU);
     if e > std::f64::consts::PI {
         e - std::f64::consts::TAU
@@ -471,7 +475,7 @@ pub fn phase_error(phase: f64, set: f64) -> f64 {
 
 /// The conservative tip–sample force F̃ of `params`' law at the tip–sample distance `d` (units
 /// of g₀; d = V_T + [`crate::ContactLaw::distance_offset`], contact where V_T ≤ 0), at rest.
-pub fn law_force(params: &Params, d: f64) -> f64 {
+pub(crate) fn law_force(params: &Params, d: f64) -> f64 {
     let law = TipSample {
         law: params.contact_law,
         stiffness: params.alpha4,

@@ -15,7 +15,7 @@
 //! exact FM steady state. The phase moves by about 2Q_K/ω_K per unit Ω, so the PLL's loop gain
 //! per cycle is g_φ; the cantilever answers within Q_K/π cycles, so gains below π/Q_K keep
 //! the loop stable ([`LoopSpec::new`]). A value is settled when both errors stay below the
-//! tolerance for [`SETTLED_CYCLES`] cycles in a row.
+//! tolerance for `SETTLED_CYCLES` cycles in a row.
 
 use super::fm::{fm_reference, phase_error, FmSpec};
 use super::observables::{observe, ObservableOptions};
@@ -27,7 +27,7 @@ use crate::params::SweepParam;
 use serde::{Deserialize, Serialize};
 
 /// Cycles in a row with both errors below the tolerance for a value to count as settled.
-pub const SETTLED_CYCLES: usize = 10;
+pub(crate) const SETTLED_CYCLES: usize = 10;
 
 /// The loop's gains and limits.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -75,7 +75,7 @@ pub struct LoopPoint {
 /// operating point at rest; counts one unit per value in `progress`.
 ///
 /// # Errors
-/// As [`fm_reference`], the model's and the integrator's; [`SimError::Cancelled`].
+/// As `fm_reference`, the model's and the integrator's; [`SimError::Cancelled`].
 pub fn fm_loop(
     spec: &FmSpec,
     gains: &LoopSpec,

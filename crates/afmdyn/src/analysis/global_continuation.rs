@@ -36,7 +36,7 @@ use std::sync::atomic::AtomicBool;
 /// Largest number of parameter values of a global continuation.
 pub const MAX_CONTINUATION_VALUES: usize = 10_000;
 /// Largest number of runs (values × samples) of a global continuation.
-pub const MAX_CONTINUATION_RUNS: usize = 2_000_000;
+pub(crate) const MAX_CONTINUATION_RUNS: usize = 2_000_000;
 /// Default relative set distance within which two attractors at consecutive values are one.
 pub const DEFAULT_MATCH_TOL: f64 = 0.1;
 
@@ -59,7 +59,7 @@ impl GlobalContinuationSpec {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `values` (1..=[`MAX_CONTINUATION_VALUES`], finite),
-    /// `samples` (values × samples ≤ [`MAX_CONTINUATION_RUNS`]) or `match_tol` (finite, ≥ 0);
+    /// `samples` (values × samples ≤ `MAX_CONTINUATION_RUNS`) or `match_tol` (finite, ≥ 0);
     /// [`SimError::Params`] for a value outside the parameter's range.
     pub fn validate(&self) -> Result<(), SimError> {
         if !(1..=MAX_CONTINUATION_VALUES).contains(&self.values.len()) {
@@ -197,7 +197,7 @@ pub fn global_continuation(
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set; [`SimError::Params`] for a value's invalid
 /// parameters.
-pub fn continue_values(
+pub(crate) fn continue_values(
     spec: &GlobalContinuationSpec,
     stored: &[ContinuationStep],
     cancel: &AtomicBool,

@@ -6,7 +6,7 @@
 //! the amplitude spectrum of a time series; frequency-modulation AFM at constant amplitude as
 //! exact periodic orbits ([`fm`]; its time-domain loop for comparison, [`fm_loop`]); force
 //! reconstruction from FM-AFM frequency shifts ([`reconstruct`]: Sader–Jarvis) and from AM
-//! amplitude and phase ([`reconstruct_am`]: the matrix method at each point's amplitude); the
+//! amplitude and phase (`reconstruct_am`: the matrix method at each point's amplitude); the
 //! exact inversion of the first-order FM relation ([`reconstruct_exact`]).
 
 pub mod am_loop;
@@ -28,16 +28,16 @@ pub mod peakforce;
 pub mod period;
 pub mod progress;
 pub mod reconstruct;
-pub mod reconstruct_am;
+pub(crate) mod reconstruct_am;
 pub mod reconstruct_exact;
 pub mod resonance;
 pub mod setpoint;
 pub mod settle;
 pub mod shooting;
-pub mod spectrum;
+pub(crate) mod spectrum;
 pub mod steady;
 pub mod stepped;
-pub mod tasks;
+pub(crate) mod tasks;
 pub mod torus;
 pub mod traces;
 
@@ -46,7 +46,7 @@ pub mod traces;
 ///
 /// # Errors
 /// [`crate::SimError::OutOfRange`] naming `name`.
-pub fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+pub(crate) fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
     if !(v.is_finite() && v > 0.0 && v < 1e-3) {
         return Err(crate::SimError::out_of_range(
             name,

@@ -23,7 +23,7 @@
 //! dense output limits the accuracy to about 10³ × its tolerance (measured on the free point
 //! mass: 1.2e-9 relative amplitude at 1e-12, 4e-11 at 1e-14). No uniform sampling. Extrema
 //! (peak force, minimum distance) are located on the dense output by a
-//! safeguarded Newton iteration ([`crate::roots`]), not taken over quadrature nodes.
+//! safeguarded Newton iteration (`crate::roots`), not taken over quadrature nodes.
 //!
 //! Units are the model's: time τ (eq. 5), lengths in g₀, forces F̃ of [`crate::contact`] (the
 //! unit of α4 V_T; k g₀ for the point-mass model), energies F̃·g₀.
@@ -36,7 +36,7 @@
 //!   and near π do not wrap.
 //! * **Sample dissipation.** E_dis = −∮ F_c ḋ dτ per period, d the tip–sample distance
 //!   (ḋ = V̇_T; for the point mass ḋ = ż), plus the kinetic-energy losses of impacts
-//!   ([`CantileverModel::impact_energy`]). Conservative parts of F_c integrate to zero over a
+//!   (`CantileverModel::impact_energy`). Conservative parts of F_c integrate to zero over a
 //!   closed orbit, so E_dis > 0 is the energy the sample takes per cycle.
 //! * **Virial.** V = (1/T)∫ F_c W(1,τ) dτ (with the impulses P W(τ_k) of impacts), F_c repulsive
 //!   positive and W positive away from the sample: V < 0 in the repulsive regime (φ < 90°),
@@ -97,9 +97,9 @@ pub use closed::{closed_forms, free_response};
 use window::{observe_window, Weighting};
 
 /// Largest accepted [`ObservableOptions::periods`].
-pub const MAX_PERIODS: usize = 1_000_000;
+pub(crate) const MAX_PERIODS: usize = 1_000_000;
 /// Largest accepted [`ObservableOptions::harmonics`].
-pub const MAX_HARMONICS: usize = 10_000;
+pub(crate) const MAX_HARMONICS: usize = 10_000;
 /// Gauss–Legendre nodes per smooth piece.
 const GL_NODES: usize = 16;
 /// Gauss–Legendre nodes per short smooth piece (module docs).
@@ -110,10 +110,10 @@ const TAPER_NORM: f64 = 2.0 / 3.0;
 /// What to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ObservableOptions {
-    /// Number of drive periods T = 2π/Ω to integrate over, in 1..=[`MAX_PERIODS`] (a multiple of
+    /// Number of drive periods T = 2π/Ω to integrate over, in 1..=`MAX_PERIODS` (a multiple of
     /// the orbit's period for a period-n orbit).
     pub periods: usize,
-    /// Highest harmonic n reported in [`Observables::harmonics`], in 1..=[`MAX_HARMONICS`]
+    /// Highest harmonic n reported in [`Observables::harmonics`], in 1..=`MAX_HARMONICS`
     /// (default 10).
     pub harmonics: usize,
 }
@@ -307,8 +307,8 @@ pub(crate) fn wrap_phase(p: f64) -> f64 {
 /// end of the window.
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] for `periods` outside 1..=[`MAX_PERIODS`] or `harmonics` outside
-/// 1..=[`MAX_HARMONICS`], or from [`free_response`]; [`SimError`] from the integrator.
+/// [`SimError::OutOfRange`] for `periods` outside 1..=`MAX_PERIODS` or `harmonics` outside
+/// 1..=`MAX_HARMONICS`, or from [`free_response`]; [`SimError`] from the integrator.
 pub fn observe(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
@@ -351,7 +351,7 @@ pub fn observe_tapered(
 ///
 /// # Errors
 /// As [`observe`]; [`SimError::OutOfRange`] when `weights` is not one finite weight per period.
-pub fn observe_weighted(
+pub(crate) fn observe_weighted(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
     weights: &[f64],

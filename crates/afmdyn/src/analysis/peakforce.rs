@@ -13,7 +13,7 @@
 //! periods), found as every steady state of afmdyn is: the transient settled by
 //! [`steady_state`] (with Newton from the transient on slowly decaying levers), then shooting
 //! on the period-n stroboscopic map for the orbit and its Floquet multipliers
-//! ([`ShootingStrategy::BroydenFromZero`] where Broyden's updates pay, [`broyden_pays`], and the
+//! ([`ShootingStrategy::BroydenFromZero`] where Broyden's updates pay, `broyden_pays`, and the
 //! law is not hysteretic, else Newton; unwatched for grazing,
 //! [`ShootingOptions::watch_grazing`]). A period-2 tapping is
 //! reported as period 2 ([`SteadyTap::period`]); double taps show as
@@ -28,7 +28,7 @@
 //! snap-off time (the last exit from contact in the cycle, from t = 0), the ringing amplitude
 //! (after snap-off, the largest |W − c F_c| with c = φ(1)ᵀK⁻¹φ(1) the lever's static
 //! compliance at the tip: the deviation from the quasi-static deflection) and the DMT fit of
-//! the retract curve ([`fit_dmt`]) on the force the instrument measures, W/c (k × deflection),
+//! the retract curve (`fit_dmt`) on the force the instrument measures, W/c (k × deflection),
 //! against the distance d (the instrument's separation, z-piezo plus deflection), and the
 //! same fit on the true force F_c: the channels are the true tip–sample force's, the fit
 //! shows the instrument method's bias.
@@ -39,7 +39,7 @@ mod setpoint;
 
 pub use filter::low_pass_periodic;
 pub(crate) use fit::MIN_FIT_POINTS;
-pub use fit::{fit_dmt, DmtFit, FIT_BAND};
+pub(crate) use fit::{fit_dmt, DmtFit, FIT_BAND};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,
     SETPOINT_TOL,
@@ -58,9 +58,9 @@ use nalgebra::{Complex, DVector};
 use serde::Serialize;
 
 /// Fewest samples of the reported cycle (the issue's ≥ 2 000 points per period).
-pub const MIN_CYCLE_SAMPLES: usize = 2_000;
+pub(crate) const MIN_CYCLE_SAMPLES: usize = 2_000;
 /// Most samples of the reported cycle (a budget: 8 bytes × 4 channels each).
-pub const MAX_CYCLE_SAMPLES: usize = 1_000_000;
+pub(crate) const MAX_CYCLE_SAMPLES: usize = 1_000_000;
 /// Samples of the retract branch resampled for the DMT fit, between the peak force and the
 /// pull-off: the contact point d₀ is the distance at the force minimum, and a coarse grid
 /// would misplace it by a sample's travel (the fit's δ^{3/2} is sensitive to d₀).
@@ -69,10 +69,10 @@ pub(crate) const FIT_SAMPLES: usize = 20_000;
 /// Options of [`steady_tap`].
 #[derive(Debug, Clone)]
 pub struct PeakForceOptions {
-    /// Samples of the reported cycle, in [`MIN_CYCLE_SAMPLES`]..=[`MAX_CYCLE_SAMPLES`].
+    /// Samples of the reported cycle, in `MIN_CYCLE_SAMPLES`..=`MAX_CYCLE_SAMPLES`.
     pub samples: usize,
     /// The force fractions (lo, hi) of the retract curve's range [adhesion, peak] the DMT fit
-    /// uses ([`FIT_BAND`], 0 ≤ lo < hi ≤ 1).
+    /// uses (`FIT_BAND`, 0 ≤ lo < hi ≤ 1).
     pub fit_band: (f64, f64),
     /// The transient's settling (the default: tolerance 1e-8, cap from the slowest decay).
     pub steady: SteadyOptions,

@@ -6,7 +6,7 @@ use nalgebra::DVector;
 pub const MAX_PERIOD: usize = 64;
 
 /// Whether two returns coincide: ‖a − b‖ ≤ tol (1 + ‖a‖).
-pub fn close(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
+pub(crate) fn close(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
     within(a.as_slice(), b.as_slice(), tol * (1.0 + a.norm()))
 }
 

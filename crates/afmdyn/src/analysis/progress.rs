@@ -56,7 +56,7 @@ impl Progress {
     }
     /// The cancel flag itself, for the analyses that take one
     /// ([`crate::analysis::bifurcation::run_sweep_cancellable`]).
-    pub fn cancel_flag(&self) -> &AtomicBool {
+    pub(crate) fn cancel_flag(&self) -> &AtomicBool {
         &self.cancel
     }
     /// `Ok` while the run may go on.

@@ -53,7 +53,7 @@ use std::f64::consts::PI;
 /// An AM approach curve to invert (one branch, the order of the approach), with the
 /// cantilever's and the drive's constants.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AmCurve {
+pub(crate) struct AmCurve {
     /// Rest distances z_c.
     pub z_c: Vec<f64>,
     /// First-harmonic amplitudes A (> 0).
@@ -81,7 +81,7 @@ impl AmCurve {
     /// [`SimError::OutOfRange`] naming the field: fewer than 3 points, lengths that differ,
     /// values not finite, amplitudes or constants not > 0, lower turning points c − A that do
     /// not fall strictly along the curve (the inversion needs them distinct and ordered).
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         positive_constants(&[
             ("spring_constant", self.spring_constant),
             ("resonance_frequency", self.resonance_frequency),
@@ -204,7 +204,7 @@ pub(crate) fn weight(d: &[f64], j: usize, c: f64, a: f64) -> f64 {
 /// The most hat weights [`matrix_inversion`] computes: 2·10⁷ ≈ 10⁴ points whose cycles each
 /// span 2000 of them, four times the 5·10⁶ of the synthetic test below (5070 points at 0.02 nm
 /// spacing, cycles of 16 to 20 nm).
-pub const MAX_AM_WEIGHTS: usize = 20_000_000;
+pub(crate) const MAX_AM_WEIGHTS: usize = 20_000_000;
 
 /// Rows between two checks of the cancel flag.
 const AM_CHUNK: usize = 64;
@@ -219,7 +219,8 @@ pub(crate) fn nodes_within(d: &[f64], c: f64, a: f64) -> std::ops::Range<usize> 
 
 /// The forward model: the integrals I_k of the piecewise-linear force with values `force` at
 /// the nodes `d` (increasing; F = 0 beyond the last) for cycles about `centre` of `amplitude`.
-pub fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &[f64]) -> Vec<f64> {
+#[cfg(test)]
+fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &[f64]) -> Vec<f64> {
     centre
         .iter()
         .zip(amplitude)
@@ -242,7 +243,10 @@ pub fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &
 /// [`MAX_AM_WEIGHTS`] weights (checked before the run); [`SimError::NoConvergence`] for a
 /// singular diagonal (a cycle that does not reach beyond its own turning point: never for A >
 /// 0); [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn matrix_inversion(curve: &AmCurve, progress: &Progress) -> Result<Reconstruction, SimError> {
+pub(crate) fn matrix_inversion(
+    curve: &AmCurve,
+    progress: &Progress,
+) -> Result<Reconstruction, SimError> {
     curve.validate()?;
     let mut order: Vec<usize> = (0..curve.z_c.len()).collect();
     let d_all = curve.turning_points();

@@ -11,12 +11,12 @@
 //! Δf_k = −f0/(2kA) Σ_j w_kj F_j, the hat weights w_kj in closed form — the matrix of
 //! Giessibl's matrix method (F. J. Giessibl, Appl. Phys. Lett. 78, 123 (2001)) in its
 //! piecewise-linear form (J. Welker, E. Illek and F. J. Giessibl, Beilstein J. Nanotechnol.
-//! 3, 238 (2012)), the weights of [`super::reconstruct_am`] with the amplitude constant.
+//! 3, 238 (2012)), the weights of `super::reconstruct_am` with the amplitude constant.
 //! A row sees the nodes within its cycle, [d_k, d_k + 2A]: the matrix is triangular. On a
 //! uniform grid (spacing h) w_kj depends on j − k only, and the forward relation is a
 //! correlation with M + 1 = ⌈2A/h⌉ + 2 weights: by FFT (O(N log N)) when M >
-//! [`DIRECT_WEIGHTS`], else summed (O(N·M)). On another grid each row's weights are computed
-//! once, at most [`MAX_EXACT_WEIGHTS`] of them (checked before the run, [`exact_weights`]).
+//! `DIRECT_WEIGHTS`, else summed (O(N·M)). On another grid each row's weights are computed
+//! once, at most `MAX_EXACT_WEIGHTS` of them (checked before the run, `exact_weights`).
 //!
 //! **Inversion (defect correction).** With SJ the Sader–Jarvis operator on the same grid and
 //! G the discrete forward relation,
@@ -31,12 +31,12 @@
 //! solver (H. J. Stetter, Numer. Math. 29, 425 (1978)), here with the matrix method's exact
 //! forward operator and Sader–Jarvis's O(N log N) inverse instead of the triangular solve's
 //! O(N·M) back substitution, whose error of one row rings through the next ones with a factor
-//! ≈ −0.83 ([`super::reconstruct_am`]).
+//! ≈ −0.83 (`super::reconstruct_am`).
 //!
 //! **Convergence.** The forward residual ρ_n = max_k |Δf_k − (G F_n)_k| / max_k |Δf_k| (all
 //! rows but the last) is computed after each step. The iteration stops when ρ ≤
 //! [`EXACT_TOLERANCE`] (the data's round-off: converged), when a step leaves more than
-//! [`STALL_RATIO`] of it (stalled: the step is kept only if it lowered ρ), or after
+//! `STALL_RATIO` of it (stalled: the step is kept only if it lowered ρ), or after
 //! [`EXACT_MAX_ITERATIONS`] steps. [`ExactRecord`] reports the steps, ρ before and after and
 //! whether it converged. Measured on the van der Waals round trip (tests/reconstruct_exact.rs):
 //! ρ falls from ~10⁻² (Sader–Jarvis) to ~10⁻⁵ in 3 to 5 steps, the residual of each row
@@ -53,7 +53,7 @@
 //! Units: any consistent set (SI: d and A in m, Δf and f0 in Hz, k in N/m → F in N, U in J).
 
 use super::progress::Progress;
-pub use super::reconstruct::ExactRecord;
+pub(crate) use super::reconstruct::ExactRecord;
 use super::reconstruct::{sader_jarvis, uniform_spacing, Reconstruction, ShiftCurve};
 use super::reconstruct_am::{nodes_within, weight};
 use crate::error::SimError;
@@ -66,18 +66,18 @@ pub const EXACT_TOLERANCE: f64 = 1e-12;
 
 /// A step that leaves more than this share of the forward residual has stalled: the
 /// iteration stops.
-pub const STALL_RATIO: f64 = 0.9;
+pub(crate) const STALL_RATIO: f64 = 0.9;
 
 /// The most correction steps.
 pub const EXACT_MAX_ITERATIONS: usize = 50;
 
 /// On a uniform grid, a forward relation with at most this many weights beyond the diagonal
 /// is summed directly; with more, by FFT.
-pub const DIRECT_WEIGHTS: usize = 64;
+pub(crate) const DIRECT_WEIGHTS: usize = 64;
 
 /// The most hat weights of the forward relation on a grid that is not uniform (8 bytes each:
 /// 160 MB at the limit), as [`super::reconstruct_am::MAX_AM_WEIGHTS`].
-pub const MAX_EXACT_WEIGHTS: usize = super::reconstruct_am::MAX_AM_WEIGHTS;
+pub(crate) const MAX_EXACT_WEIGHTS: usize = super::reconstruct_am::MAX_AM_WEIGHTS;
 
 /// The discrete forward relation of a curve ([module doc](self)).
 enum Forward {
@@ -109,7 +109,7 @@ fn toeplitz_weights(n: usize, h: f64, a: f64) -> Vec<f64> {
 
 /// The number of hat weights the forward relation of `curve` needs on a grid that is not
 /// uniform (rows 0..N − 1, each its nodes within the cycle), or 0 on a uniform grid.
-pub fn exact_weights(curve: &ShiftCurve) -> usize {
+pub(crate) fn exact_weights(curve: &ShiftCurve) -> usize {
     let d = &curve.distance;
     if uniform_spacing(d).is_some() {
         return 0;
@@ -125,7 +125,7 @@ pub fn exact_weights(curve: &ShiftCurve) -> usize {
 /// # Errors
 /// As [`ShiftCurve::method`]; [`SimError::OutOfRange`] naming `distance` when a grid that is
 /// not uniform needs more than [`MAX_EXACT_WEIGHTS`] weights ([`exact_weights`]).
-pub fn check_exact(curve: &ShiftCurve) -> Result<(), SimError> {
+pub(crate) fn check_exact(curve: &ShiftCurve) -> Result<(), SimError> {
     curve.method()?;
     let weights = exact_weights(curve);
     if weights > MAX_EXACT_WEIGHTS {
@@ -243,7 +243,7 @@ fn shifts(forward: &Forward, curve: &ShiftCurve, force: &[f64]) -> Vec<f64> {
 /// steps.
 ///
 /// # Errors
-/// As [`check_exact`]; [`SimError::Cancelled`] once `progress` is cancelled.
+/// As `check_exact`; [`SimError::Cancelled`] once `progress` is cancelled.
 pub fn exact_inversion(
     curve: &ShiftCurve,
     progress: &Progress,

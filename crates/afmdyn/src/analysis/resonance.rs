@@ -31,7 +31,7 @@ pub fn mode_band(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for k outside 1..=N; [`SimError::Params`] for invalid parameters.
-pub fn mode_resonance(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
+pub(crate) fn mode_resonance(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
     let (free, _) = spectrum(params)?;
     if k == 0 || k > free.omega.len() {
         return Err(SimError::out_of_range(

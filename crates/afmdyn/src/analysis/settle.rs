@@ -4,12 +4,12 @@
 //!
 //! A lever of quality factor Q takes ~Q ln(1/tol)/π drive periods for its returns to repeat
 //! to the tolerance tol (≈ 2 900 periods at Q = 500, tol = 1e-8). So every
-//! [`SettleOptions::chunk_periods`] periods Newton's method is tried from the current state
+//! `SettleOptions::chunk_periods` periods Newton's method is tried from the current state
 //! (undamped, [`ShootingStrategy::Undamped`]: from a transient far from the orbit the damped
 //! iteration's halvings rarely converge and each costs a flow, and the next attempt starts
 //! nearer); a *stable* orbit it finds is accepted only once the trajectory is seen to go to it
-//! — it has come closer over two further chunks and is within [`SettleOptions::settled`] of it,
-//! or has arrived on it, or (where [`SettleOptions::linear`] allows it) has twice come closer
+//! — it has come closer over two further chunks and is within `SettleOptions::settled` of it,
+//! or has arrived on it, or (where `SettleOptions::linear` allows it) has twice come closer
 //! at the rate |μ₁|^chunk of the orbit's leading Floquet multiplier — so it is the attractor
 //! the motion goes to, not another orbit Newton happened to reach from a state on the way.
 //! (Newton's method for periodic orbits: Seydel, *Practical Bifurcation and Stability
@@ -18,9 +18,9 @@
 //! How near is near enough depends on what else is there: on a lightly damped lever the basins
 //! of coexisting orbits wind round each other, and a transient far from every orbit is the free
 //! oscillation, decaying at the rate e^{−π/Q} that is also |μ₁| of every orbit with a complex
-//! pair of multipliers. A start is decided there only within [`CENSUS_SETTLED`], which the
+//! pair of multipliers. A start is decided there only within `CENSUS_SETTLED`, which the
 //! measurement quoted with it shows to be safe by a factor of 10 on the RTESPA-300 probe; a
-//! stepped sweep, whose transient starts on the previous value's orbit, keeps [`SETTLED`] and
+//! stepped sweep, whose transient starts on the previous value's orbit, keeps `SETTLED` and
 //! the rate test.
 
 use super::shooting::{shoot, ShootingOptions, ShootingStrategy};
@@ -31,12 +31,12 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 /// Chunks of [`SettleOptions::chunk_periods`] during which Newton is retried before the
 /// motion is left to classification by integration alone.
-pub const NEWTON_CHUNKS: usize = 40;
+pub(crate) const NEWTON_CHUNKS: usize = 40;
 
 /// Relative distance (to 1 + ‖z‖) within which a transient that keeps approaching a stable
 /// orbit is taken to have reached it in a stepped sweep (which starts from the previous
 /// value's orbit).
-pub const SETTLED: f64 = 5e-2;
+pub(crate) const SETTLED: f64 = 5e-2;
 
 /// Relative distance within which a transient from an arbitrary start that keeps approaching
 /// a stable orbit is taken to go to it ([`super::steady::steady_state`]). On the RTESPA-300
@@ -44,11 +44,11 @@ pub const SETTLED: f64 = 5e-2;
 /// `examples/high_q.rs`): accepted at 5e-2 … 1.4e-1 by the rate test, 13 of 40 starts went to
 /// the other orbit; at 1e-2 every start was decided right, at 1e-3 (a factor 10 of margin)
 /// too, after 1 868 drive periods on average against 2 849 for the returns to repeat to 1e-8.
-pub const CENSUS_SETTLED: f64 = 1e-3;
+pub(crate) const CENSUS_SETTLED: f64 = 1e-3;
 
 /// Options of [`newton_from_transient`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SettleOptions {
+pub(crate) struct SettleOptions {
     /// Newton shooting from the transient (undamped, for each period tried).
     pub newton: ShootingOptions,
     /// Drive periods between Newton attempts (≥ 1).
@@ -84,7 +84,7 @@ pub struct Found {
 
 /// What [`newton_from_transient`] reached.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Settling {
+pub(crate) struct Settling {
     /// The stable orbit the transient was seen to go to (`None`: not within the budget).
     pub found: Option<Found>,
     /// The transient's state at the end (τ a multiple of the drive period, shape `[2N]`).
@@ -124,7 +124,7 @@ impl Candidate {
 /// (2 ≤ n ≤ `max_period`, n ≤ half the returns) at which the newest return comes closest to
 /// an earlier one, the smallest n within twice the least distance (a period-n cycle being
 /// approached repeats best at its period; its multiples repeat no better).
-pub fn period_guesses(returns: &[DVector<f64>], max_period: usize) -> Vec<usize> {
+pub(crate) fn period_guesses(returns: &[DVector<f64>], max_period: usize) -> Vec<usize> {
     let mut out = vec![1];
     let Some(last) = returns.len().checked_sub(1) else {
         return out;
@@ -152,7 +152,7 @@ pub fn period_guesses(returns: &[DVector<f64>], max_period: usize) -> Vec<usize>
 ///
 /// # Errors
 /// [`SimError`] from the integrator (a failing Newton attempt is not an error).
-pub fn newton_from_transient(
+pub(crate) fn newton_from_transient(
     integ: &mut dyn Integrator,
     z0: &DVector<f64>,
     period: Option<usize>,

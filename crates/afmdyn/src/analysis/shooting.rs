@@ -70,7 +70,7 @@ impl ShootingOptions {
 /// How [`shoot`] solves for an orbit, and what it forms of the orbit it finds. A *finished*
 /// orbit is refused where it does not close in its region ([`DiscreteMap::closes`]), reduced to
 /// its minimal period (an orbit found as period n may repeat after a divisor of n,
-/// [`proper_period`]), and has its n section points and, watched
+/// `proper_period`), and has its n section points and, watched
 /// ([`ShootingOptions::watch_grazing`]), its distance to grazing; an *unfinished* one is refused
 /// as well where it does not close, but has only its multipliers formed (no section points but
 /// its state, no minimal period, no distance to grazing: the flows a finished orbit takes).
@@ -92,7 +92,7 @@ pub enum ShootingStrategy {
     /// [`ShootingStrategy::Newton`]'s from the same guess whenever it takes full steps.
     Undamped,
     /// Newton globalised: each step is backtracked by a line search on ½‖F‖² with Armijo's
-    /// sufficient-decrease condition ([`LINE_SEARCH_MIN_STEP`]; Dennis & Schnabel, *Numerical
+    /// sufficient-decrease condition (`LINE_SEARCH_MIN_STEP`; Dennis & Schnabel, *Numerical
     /// Methods for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996, §6.3 and
     /// Algorithm A6.3.1), so that a guess farther from the orbit than Newton's basin of
     /// quadratic convergence — a point of a chaotic attractor near one of its unstable periodic
@@ -107,7 +107,7 @@ pub enum ShootingStrategy {
     /// variational flow's work), the Jacobian M − I of F updated after each step δ by
     /// Broyden's rank-one secant update J ← J + (ΔF − J δ) δᵀ/(δᵀδ) (Broyden, *Math. Comp.* 19
     /// (1965) 577; Dennis & Schnabel 1996, §8.1), and the converged orbit takes one variational
-    /// flow for its monodromy matrix — whose residual must be within [`VARIATIONAL_SLACK`]
+    /// flow for its monodromy matrix — whose residual must be within `VARIATIONAL_SLACK`
     /// tolerances (the two kinds of flow take different steps), else undamped Newton steps
     /// follow from it. A step that does not lower ‖F‖ ends the solve, as undamped Newton's; an
     /// estimate that is not d×d is refused ([`SimError::OutOfRange`]). The orbit is unfinished.
@@ -125,7 +125,7 @@ pub enum ShootingStrategy {
     /// is unfinished (period 1, its state its one section point), Newton's finished.
     ///
     /// It pays for a strongly contracting map whose monodromy matrix costs variational
-    /// equations step by step ([`broyden_pays`]): there the multipliers are small (2–3e-2 on
+    /// equations step by step (`broyden_pays`): there the multipliers are small (2–3e-2 on
     /// the steady PeakForce tap of a ScanAsyst-Air-like probe at f₀/f_m = 100, whose ringing
     /// after each tap decays over the cycle's lever periods), so M − I ≈ −I makes the first
     /// step the map's own iterate — the transient continued — after which the secant updates
@@ -160,7 +160,7 @@ pub enum Guess<'a> {
     /// periodic orbits embedded in it, and passes close to a period-n one where it nearly
     /// repeats after n periods; Auerbach, Cvitanović, Eckmann, Gunaratne & Procaccia, *Phys.
     /// Rev. Lett.* 58 (1987) 2387; Lathrop & Kostelich, *Phys. Rev. A* 40 (1989) 4028) are the
-    /// starts, up to [`SECTION_STARTS`] of them in increasing order of that return, each solved
+    /// starts, up to `SECTION_STARTS` of them in increasing order of that return, each solved
     /// by the strategy (for a chaotic attractor [`ShootingStrategy::Globalised`]); the first
     /// orbit reached is the solve's. [`SimError::OutOfRange`] when the section has fewer than
     /// n + 1 points; [`SimError::NoConvergence`] (the smallest residual reached) when no start
@@ -176,7 +176,7 @@ impl<'a> From<&'a DVector<f64>> for Guess<'a> {
 
 /// Distance to grazing below which an orbit is flagged as grazing: a local extremum of V_T
 /// within 1e-3 gap units of the sample, or a switching with |dV_T/dτ|/Ω below 1e-3.
-pub const GRAZING_TOL: f64 = 1e-3;
+pub(crate) const GRAZING_TOL: f64 = 1e-3;
 
 /// How an orbit is (or would become) unstable, from the multiplier of largest modulus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -239,7 +239,7 @@ pub struct PeriodicOrbit {
     /// Distance to grazing (see [`crate::maps::flow::FlowMap::grazing_distance`]); NaN where
     /// it is not measured (unwatched, [`ShootingOptions::watch_grazing`], or unfinished).
     pub grazing_distance: f64,
-    /// The orbit is (near) grazing: `grazing_distance` < [`GRAZING_TOL`].
+    /// The orbit is (near) grazing: `grazing_distance` < `GRAZING_TOL`.
     pub grazing: bool,
     /// Switchings per cycle.
     pub switchings: usize,
@@ -255,7 +255,7 @@ pub fn floquet_multipliers(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
 }
 
 /// How many section points of an attractor [`shoot`] tries as starts at most ([`Guess::Section`]).
-pub const SECTION_STARTS: usize = 16;
+pub(crate) const SECTION_STARTS: usize = 16;
 
 /// Whether Newton solves with the integrator of `opts` for `model` gain from starting with
 /// Broyden's updates and flows without the variational equations ([`ShootingStrategy::Broyden`]):
@@ -269,7 +269,7 @@ pub const SECTION_STARTS: usize = 16;
 /// variational flow per iterate. Not with the exact propagator, whose monodromy matrix is a product
 /// of stint transitions at about the cost of the flow itself: there Broyden's extra iterations
 /// would cost more than they save.
-pub fn broyden_pays(opts: IntegratorOptions, model: &CantileverModel) -> bool {
+pub(crate) fn broyden_pays(opts: IntegratorOptions, model: &CantileverModel) -> bool {
     opts.kind.resolve(model) != IntegratorKind::Exact
 }
 
@@ -277,12 +277,12 @@ pub fn broyden_pays(opts: IntegratorOptions, model: &CantileverModel) -> bool {
 /// [`ShootingStrategy::Broyden`] converged on flows without them may miss it by: the two flows'
 /// steps differ, so their maps differ by the integration error (measured 1e-10 to 4e-10 at the
 /// adaptive integrator's tolerance 1e-10, point-mass DMT; nothing for the exact propagator).
-pub const VARIATIONAL_SLACK: f64 = 10.0;
+pub(crate) const VARIATIONAL_SLACK: f64 = 10.0;
 
 /// The smallest step fraction λ the line search of [`ShootingStrategy::Globalised`] tries: below it
 /// the Newton direction no longer lowers ‖F‖ (a local minimum of ‖F‖ that is not a zero, or a kink
 /// of the map at a switching) and the solve fails.
-pub const LINE_SEARCH_MIN_STEP: f64 = 1e-8;
+pub(crate) const LINE_SEARCH_MIN_STEP: f64 = 1e-8;
 
 /// Floquet multipliers of a monodromy matrix (decreasing modulus), whether all lie inside the
 /// unit circle, and the type of the critical one.
@@ -298,7 +298,7 @@ pub(crate) fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, I
 /// Newton solve for Pⁿ(z) = z from a guess (a period carried along a sweep, a transient's
 /// guess) converges to it as readily as to a true period-n orbit; the orbit's own returns tell
 /// them apart. `None` when no proper divisor returns (n is the minimal period).
-pub fn proper_period(section: &[DVector<f64>], tol: f64) -> Option<usize> {
+pub(crate) fn proper_period(section: &[DVector<f64>], tol: f64) -> Option<usize> {
     let n = section.len();
     (1..n)
         .filter(|&d| n.is_multiple_of(d))

@@ -6,7 +6,7 @@
 //! Schafer, *Discrete-Time Signal Processing*, 3rd ed., §8.1).
 
 /// Samples of the end of a run the spectrum is taken over by default (2²⁰).
-pub const SPECTRUM_SAMPLES: usize = 1 << 20;
+pub(crate) const SPECTRUM_SAMPLES: usize = 1 << 20;
 
 /// The amplitude spectrum of `x` sampled `samples_per_period` times per drive period 2π/Ω:
 /// pairs (frequency in the units of Ω, amplitude in the units of x), `[L/2 + 1]` for

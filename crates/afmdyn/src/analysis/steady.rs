@@ -30,7 +30,7 @@ pub struct SteadyOptions {
     /// Periods recorded for a motion classified nonperiodic.
     pub nonperiodic_record: usize,
     /// On a slowly decaying model (one whose slowest free mode takes more than
-    /// [`NEWTON_DECAY_PERIODS`] to decay by `tol`: Q above ~170 at resonance), decide by Newton
+    /// `NEWTON_DECAY_PERIODS` to decay by `tol`: Q above ~170 at resonance), decide by Newton
     /// shooting from the transient as soon as the motion is seen to go to a stable orbit
     /// ([`super::settle`]) instead of waiting for its returns to repeat to `tol`.
     pub newton: bool,
@@ -57,7 +57,7 @@ pub const MIN_TRANSIENT_PERIODS: usize = 1_500;
 /// within a few hundred periods, which Newton's attempts — each some six flows with the
 /// variational equations, every 100 periods — would not shorten: the paper's beam decays in
 /// 248 periods at Ω = 2.6 and 477 at Ω = 5, the RTESPA-300 (Q = 500) in 2 932.
-pub const NEWTON_DECAY_PERIODS: f64 = 1_000.0;
+pub(crate) const NEWTON_DECAY_PERIODS: f64 = 1_000.0;
 
 /// Decay times ([`decay_periods`]) of the slowest free mode in a derived transient cap: a
 /// nonlinear orbit's leading Floquet multiplier may lie closer to the unit circle than the
@@ -388,10 +388,10 @@ impl ReturnHistory {
 
 /// Smallest tolerance of the return test: returns of a map computed to round-off (~1e-15
 /// relative) coincide no closer.
-pub const MIN_TOL: f64 = 1e-14;
+pub(crate) const MIN_TOL: f64 = 1e-14;
 /// Largest tolerance of the return test: beyond it a slowly converging transient or a
 /// chaotic motion is taken for a period-n orbit.
-pub const MAX_TOL: f64 = 1e-3;
+pub(crate) const MAX_TOL: f64 = 1e-3;
 
 /// Largest transient cap of a steady-state search, in drive periods.
 pub const MAX_STEADY_PERIODS: usize = 10_000_000;
@@ -400,7 +400,7 @@ impl SteadyOptions {
     /// Check the options (the one place of their limits; the request layer calls it).
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `tol` ([[`MIN_TOL`], [`MAX_TOL`]]), `max_period`
+    /// [`SimError::OutOfRange`] naming `tol` ([`MIN_TOL`, `MAX_TOL`]), `max_period`
     /// (1..=64) or `max_periods` (1..=[`MAX_STEADY_PERIODS`]).
     pub fn validate(&self) -> Result<(), SimError> {
         if !(MIN_TOL..=MAX_TOL).contains(&self.tol) {

@@ -1,6 +1,6 @@
 //! Quasi-periodic steady states of a two-frequency drive (bimodal AFM at a lever's true mode
 //! ratio) as invariant circles of the stroboscopic map: [`invariant_circle`] finds the
-//! circle by Newton on the map of [`crate::maps::circle`] (collocation on one orbit segment of
+//! circle by Newton on the map of `crate::maps::circle` (collocation on one orbit segment of
 //! M drive periods, closed through the trigonometric interpolant; the module docs there give
 //! the equations and their source), and [`observe_circle`] averages the AFM observables over
 //! it — each component's amplitude, phase, virial and dissipated energy from the torus.
@@ -29,7 +29,7 @@ use nalgebra::{DMatrix, DVector};
 /// between two nodes ([`InvariantCircle::smooth`]): on the test levers a node next to such a
 /// crossing comes within 2e-3 (gap units) of grazing, a smooth circle's nodes stay beyond
 /// 5e-2 (`tests/torus.rs`).
-pub const NEAR_GRAZING: f64 = 1e-2;
+pub(crate) const NEAR_GRAZING: f64 = 1e-2;
 
 /// Default number of nodes asked for: the circle takes the smallest convergent denominator of
 /// the rotation at or above it ([`node_count`]).
@@ -38,7 +38,7 @@ pub(crate) const DEFAULT_NODES: usize = 24;
 /// Options of [`invariant_circle`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CircleOptions {
-    /// Nodes asked for (≥ 1; [`node_count`] rounds up to a convergent's or semiconvergent's
+    /// Nodes asked for (≥ 1; `node_count` rounds up to a convergent's or semiconvergent's
     /// denominator).
     pub nodes: usize,
     /// Newton's tolerance and iteration cap.
@@ -61,7 +61,7 @@ pub struct InvariantCircle {
     pub nodes: CircleNodes,
     /// x_k = u(θ_k) at τ = kT, k = 0..M−1 (M states `[2N]`).
     pub states: Vec<DVector<f64>>,
-    /// ∂G at the solution (2N×2N), G the circle's map ([`CircleMap`]), from its linearisation
+    /// ∂G at the solution (2N×2N), G the circle's map (`CircleMap`), from its linearisation
     /// there: Broyden's first estimate when the circle is continued ([`continue_circle`]).
     pub jacobian: DMatrix<f64>,
     /// ‖F‖ after each Newton iteration.
@@ -72,12 +72,12 @@ pub struct InvariantCircle {
     pub stable: bool,
     /// Distance to grazing over the segment ([`crate::maps::flow::FlowMap::grazing_distance`]).
     pub grazing_distance: f64,
-    /// `grazing_distance` < [`GRAZING_TOL`]: the circle may not be smooth there, and the
+    /// `grazing_distance` < `GRAZING_TOL`: the circle may not be smooth there, and the
     /// interpolation's error not small.
     pub grazing: bool,
     /// Switchings (contacts formed and broken, impacts) in each node's drive period, `[M]`.
     pub switchings: Vec<usize>,
-    /// Whether the circle is smooth as far as its nodes show: no node within [`NEAR_GRAZING`]
+    /// Whether the circle is smooth as far as its nodes show: no node within `NEAR_GRAZING`
     /// of grazing. A circle that crosses a grazing bifurcation between two nodes (a touch of
     /// the sample appears at some phases of the second drive and not at others, as mode 2's
     /// ripple reaches the sample near the bottom of the first mode's swing; the number of
@@ -93,7 +93,7 @@ pub struct InvariantCircle {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] unless the drive has exactly one further component.
-pub fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
+pub(crate) fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
     let comps: Vec<_> = model.params().components().collect();
     match comps.as_slice() {
         [c] => Ok((u64::from(c.ratio[0]), u64::from(c.ratio[1]))),
@@ -107,7 +107,7 @@ pub fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
 
 /// The invariant circle of `model`'s two-frequency drive near `guess` (the state at τ = 0,
 /// `[2N]`): Newton ([`shoot`]) on the circle's map of `opts.nodes` nodes
-/// ([`node_count`]), its stability and its distance to grazing from the last Newton
+/// (`node_count`), its stability and its distance to grazing from the last Newton
 /// linearisation (at the solution).
 ///
 /// # Errors
@@ -204,13 +204,13 @@ fn solve(
     })
 }
 
-/// The AFM observables averaged over the circle ([`observe_weighted`] over its M-period
+/// The AFM observables averaged over the circle (`observe_weighted` over its M-period
 /// segment with its quadrature weights): the primary's harmonics, each drive component's
 /// amplitude, phase, virial and dissipated energy ([`Observables::components`]), the mean
 /// force, the energy balance per mode; extremes over the segment. Per drive period 2π/Ω.
 ///
 /// # Errors
-/// As [`observe_weighted`].
+/// As `observe_weighted`.
 pub fn observe_circle(
     model: &CantileverModel,
     integ: IntegratorOptions,

@@ -7,7 +7,7 @@
 //! (1998)).
 //!
 //! Every trace covers the same `periods` drive periods (the largest period of the recorded
-//! points, at most [`MAX_TRACE_PERIODS`]), so the traces form arrays of shape
+//! points, at most `MAX_TRACE_PERIODS`), so the traces form arrays of shape
 //! `[points, periods × samples_per_period]` on one time axis.
 
 use crate::error::SimError;
@@ -22,9 +22,9 @@ use nalgebra::DVector;
 pub(crate) type TracePoint<'a> = (f64, &'a DVector<f64>, Option<usize>);
 
 /// Most drive periods of a trace (a period-n orbit with n larger is recorded over this many).
-pub const MAX_TRACE_PERIODS: usize = 16;
+pub(crate) const MAX_TRACE_PERIODS: usize = 16;
 /// Most samples per drive period of a trace.
-pub const MAX_TRACE_SAMPLES: usize = 10_000;
+pub(crate) const MAX_TRACE_SAMPLES: usize = 10_000;
 
 /// The traces of a sweep, arrays row per point (dimensionless: τ, g₀, F̃).
 #[derive(Debug, Clone, PartialEq)]
@@ -50,7 +50,7 @@ pub struct Traces {
 /// `samples_per_period` samples per drive period.
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming `trace_samples` outside 2..=[`MAX_TRACE_SAMPLES`]; the
+/// [`SimError::OutOfRange`] naming `trace_samples` outside 2..=`MAX_TRACE_SAMPLES`; the
 /// model's or integrator's errors for a point.
 pub fn traces(
     base: &Params,

@@ -55,7 +55,7 @@ pub(crate) fn van_der_waals(h: f64, d: f64) -> [f64; 3] {
     [-h / (d * d), 2.0 * h / (d * d * d), -h / d]
 }
 
-/// DMT's (and the electrostatic law's) prepare step ([`Law::prepare`]): the law with α4, α6,
+/// DMT's (and the electrostatic law's) prepare step (`Law::prepare`): the law with α4, α6,
 /// ã₀ and its long-range force at contact, [F, dF/dd, U] at d = ã₀ (DMT's adhesion
 /// F = −H̃/ã₀²), computed once. Outside contact the long-range attraction at d = ã₀ − δ > ã₀;
 /// in contact the adhesion at d = ã₀ plus Hertz and Kelvin–Voigt (module docs).
@@ -75,7 +75,7 @@ pub struct PreparedDmt<L> {
 
 impl<L: Law> PreparedDmt<L> {
     /// `law` (with ã₀ its [`Law::distance_offset`]) with α4 = `k`, α6 = `c`.
-    pub fn new(law: L, k: f64, c: f64) -> Self {
+    pub(crate) fn new(law: L, k: f64, c: f64) -> Self {
         let a0 = law.distance_offset();
         PreparedDmt {
             law,

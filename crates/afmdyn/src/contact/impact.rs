@@ -8,7 +8,7 @@ use super::{Law, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default coefficient of restitution of the impact law.
-pub const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
+pub(crate) const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
 
 /// The impact law's group.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -106,7 +106,7 @@ impl Law for JkrLaw {
     }
 }
 
-/// JKR's prepare step ([`Law::prepare`]): the contact's constants ([`Jkr::new`]: two square
+/// JKR's prepare step (`Law::prepare`): the contact's constants ([`Jkr::new`]: two square
 /// roots and a cube root of α4 and P̃) with the Kelvin–Voigt group α6. No force outside
 /// contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -178,8 +178,8 @@ impl Jkr {
     }
 
     /// F_c(δ, δ̇) in contact with its partials, α6 = `c` the Kelvin–Voigt group (module docs):
-    /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) ([`Jkr::radius_variable`]). The force of
-    /// [`JkrLaw`]'s [`Law::force`] in contact, from constants computed once
+    /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) (`Jkr::radius_variable`). The force of
+    /// [`JkrLaw`]'s `Law::force` in contact, from constants computed once
     /// ([`PreparedJkr`]).
     pub fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
         let q = self.radius_variable(delta);
@@ -201,7 +201,7 @@ impl Jkr {
     }
 
     /// The potential U(δ) in contact: [`Jkr::potential`] at q(δ).
-    pub fn contact_potential(&self, delta: f64) -> f64 {
+    pub(crate) fn contact_potential(&self, delta: f64) -> f64 {
         self.potential(self.radius_variable(delta))
     }
 
@@ -271,7 +271,7 @@ impl Jkr {
     /// monotonically; the start is the smaller of two upper bounds, max((2δ)^{1/4}, (2c)^{1/3})
     /// (where q⁴/2 bounds both δ and c q) and q_f + √((δ − δ_f)/(6q_f²)) (δ(q) − δ_f ≥
     /// 6q_f²(q − q_f)²), the second exact to leading order at the break, where δ′(q_f) = 0.
-    pub fn radius_variable(&self, delta: f64) -> f64 {
+    pub(crate) fn radius_variable(&self, delta: f64) -> f64 {
         if delta.is_nan() || delta <= self.indentation(self.q_break) {
             return self.q_break;
         }

@@ -32,7 +32,7 @@ pub struct Param {
 
 impl Param {
     /// A placeholder (no name), to fill tables built at compile time.
-    pub const EMPTY: Param = Param {
+    pub(crate) const EMPTY: Param = Param {
         name: "",
         symbol: "",
         unit: "",
@@ -107,18 +107,18 @@ pub fn reduced_modulus(e_tip: f64, nu_tip: f64, e_sample: f64, nu_sample: f64) -
 
 impl SampleSi {
     /// The Hertz group α4 = (4/3) E* √R g₀^{3/2}/F_s (Johnson, *Contact Mechanics*, §4.2).
-    pub fn hertz_alpha4(&self) -> f64 {
+    pub(crate) fn hertz_alpha4(&self) -> f64 {
         let (e, rr) = (self.e_star.unwrap_or(0.0), self.radius.unwrap_or(0.0));
         4.0 / 3.0 * e * rr.sqrt() * self.g0.powf(1.5) / self.force
     }
     /// The Kelvin–Voigt group α6 = η √(R g₀) g₀/(t_s F_s): the damper η a δ̇ with the contact
     /// radius a = √(Rδ).
-    pub fn kelvin_voigt_alpha6(&self) -> f64 {
+    pub(crate) fn kelvin_voigt_alpha6(&self) -> f64 {
         let rr = self.radius.unwrap_or(0.0);
         self.viscosity.unwrap_or(0.0) * (rr * self.g0).sqrt() * self.g0 / (self.time * self.force)
     }
     /// A viscous damper's α6 = c g₀/(t_s F_s) of `damping` c (N s/m).
-    pub fn damper_alpha6(&self) -> f64 {
+    pub(crate) fn damper_alpha6(&self) -> f64 {
         self.damping.unwrap_or(0.0) * self.g0 / (self.time * self.force)
     }
 }
@@ -140,16 +140,16 @@ pub trait Law: Copy + Sized {
     /// The keys a probe file's `[sample]` table may hold for the law ([`crate::probe`]).
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "z_c"];
     /// Whether the law's contact is Hertz's sphere of the tip's radius, α4 its Hertz group
-    /// (4/3)E*√R g₀^{3/2}/F_s ([`SampleSi::hertz_alpha4`]): a probe's tip radius and sample
+    /// (4/3)E*√R g₀^{3/2}/F_s (`SampleSi::hertz_alpha4`): a probe's tip radius and sample
     /// modulus set it, and a fitted α4 is a modulus.
     const TIP_RADIUS: bool = false;
 
     /// The law's constants, derived once from its groups and α4, α6 ([`Law::prepare`]);
-    /// [`super::AsGiven`] for a law that derives nothing worth keeping.
+    /// `super::AsGiven` for a law that derives nothing worth keeping.
     type Prepared: PreparedForce + Copy + std::fmt::Debug + PartialEq;
 
     /// The prepare step: the law's groups with α4 = `k` and α6 = `c` turned into the constants
-    /// its force needs, once per model ([`super::PreparedLaw`]). Evaluating the result is
+    /// its force needs, once per model (`super::PreparedLaw`). Evaluating the result is
     /// [`Law::force`], [`Law::potential`] and [`Law::dissipative`] bit for bit (the same
     /// operations in the same order).
     fn prepare(&self, k: f64, c: f64) -> Self::Prepared;

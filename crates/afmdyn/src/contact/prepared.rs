@@ -61,7 +61,7 @@ pub(crate) use as_given;
 /// force evaluation. Every evaluation is the law's own ([`TipSampleLaw`] of [`TipSample`]) with
 /// the same operations in the same order, so the same numbers bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PreparedLaw {
+pub(crate) struct PreparedLaw {
     ts: TipSample,
     /// The law's constants ([`ContactLaw::prepare`] of α4 and α6).
     prepared: PreparedContact,
@@ -69,7 +69,7 @@ pub struct PreparedLaw {
 
 impl PreparedLaw {
     /// Prepare `ts`'s law with its α4 and α6.
-    pub fn new(ts: TipSample) -> PreparedLaw {
+    pub(crate) fn new(ts: TipSample) -> PreparedLaw {
         PreparedLaw {
             ts,
             prepared: ts.law.prepare(ts.stiffness, ts.damping),
@@ -77,17 +77,18 @@ impl PreparedLaw {
     }
 
     /// The law with its α4 and α6.
-    pub fn tip_sample(&self) -> &TipSample {
+    #[cfg(test)]
+    pub(crate) fn tip_sample(&self) -> &TipSample {
         &self.ts
     }
 
     /// The law.
-    pub fn law(&self) -> &ContactLaw {
+    pub(crate) fn law(&self) -> &ContactLaw {
         &self.ts.law
     }
 
     /// α6: the damper of the linear and Hertz laws, the Kelvin–Voigt group of the others.
-    pub fn damping(&self) -> f64 {
+    pub(crate) fn damping(&self) -> f64 {
         self.ts.damping
     }
 }

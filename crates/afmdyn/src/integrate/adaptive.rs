@@ -13,7 +13,7 @@
 //! round-off dead band (1e-12 of the guard's scale) so that a trajectory leaving the surface
 //! tangentially (a release from sticking) does not re-trigger. The leftmost zero is bracketed
 //! from the last point where g > 0 (after an event: the first maximum of g) and located by
-//! safeguarded Newton on the dense output ([`crate::roots`]); it is then polished by Newton's
+//! safeguarded Newton on the dense output (`crate::roots`); it is then polished by Newton's
 //! method on g(τ) with every iterate integrated afresh from the step's start, so the event time
 //! is exact to the integration tolerance, not to the interpolant.
 //!
@@ -131,9 +131,6 @@ impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
             .finish_non_exhaustive()
     }
 }
-
-/// Backwards-compatible name of [`Adaptive`] (the linear law's independent oracle).
-pub type AdaptiveOracle = Adaptive;
 
 impl<S: TipSampleSystem + Clone> Adaptive<S> {
     /// An integrator of `model` with relative and absolute tolerance `tol` of the DOP853 error

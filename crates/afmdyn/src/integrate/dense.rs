@@ -17,7 +17,7 @@ pub(crate) type EachSample<'a> = dyn FnMut(usize, f64, &[f64]) -> Result<(), Sim
 /// How [`sample_dense`] advances an integrator with spans ([`Integrator::spans`]: the exact
 /// propagator, the split integrator).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SpanSampling {
+pub(crate) enum SpanSampling {
     /// Advanced to each sample in turn ([`advance`]), its steps cut there (the lock-in's
     /// demodulation, whose samples were always taken so).
     Cut,
@@ -29,7 +29,7 @@ pub enum SpanSampling {
 
 /// Whether [`sample_dense`] samples its start τ₀ too.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StartSample {
+pub(crate) enum StartSample {
     /// No: τ₀ is the integrator's time, the samples are j = 1, …, n (the lock-in's
     /// demodulation, [`crate::analysis::am_loop`]).
     Excluded,
@@ -54,7 +54,7 @@ pub enum StartSample {
 ///
 /// # Errors
 /// As the integrator, or what `each` returns.
-pub fn sample_dense(
+pub(crate) fn sample_dense(
     integ: &mut dyn Integrator,
     n: usize,
     time: &dyn Fn(usize) -> f64,

@@ -338,7 +338,7 @@ fn check_supported(model: &CantileverModel, kind: IntegratorKind) -> Result<(), 
 }
 
 /// Refuse a start at or beyond the divergence threshold of the integrators (|z| ≥ 1e12,
-/// [`crate::params::STATE_NORM_MAX`]), as [`build`] does before any work.
+/// `crate::params::STATE_NORM_MAX`), as [`build`] does before any work.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming the initial state.

@@ -15,7 +15,7 @@ pub(crate) struct PeriodGrid {
 
 impl PeriodGrid {
     /// The grid of `m` sub-steps per period `period`.
-    pub fn new(period: f64, m: usize) -> Self {
+    pub(crate) fn new(period: f64, m: usize) -> Self {
         let m = m.max(1);
         PeriodGrid {
             period,

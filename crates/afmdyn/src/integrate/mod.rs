@@ -33,7 +33,7 @@
 //! [`SwitchEvent`].
 
 pub mod adaptive;
-pub mod dense;
+pub(crate) mod dense;
 mod dop853;
 pub mod exact;
 mod factory;
@@ -79,7 +79,7 @@ pub struct SwitchEvent {
 
 impl Step {
     /// A step over [τ₀, τ₁] in `region` that ends without an event (τ₁ = τ₀: no step taken).
-    pub fn plain(tau0: f64, tau1: f64, region: Region) -> Step {
+    pub(crate) fn plain(tau0: f64, tau1: f64, region: Region) -> Step {
         Step {
             tau0,
             tau1,
@@ -89,7 +89,7 @@ impl Step {
     }
 
     /// A step of `model` in region `from` that ends at a plain switching at (τ_s, z_s).
-    pub fn switched<S: TipSampleSystem + ?Sized>(
+    pub(crate) fn switched<S: TipSampleSystem + ?Sized>(
         model: &S,
         tau0: f64,
         from: Region,
@@ -180,7 +180,7 @@ pub trait Integrator: Send {
     fn dense_state(&mut self, tau: f64) -> DVector<f64>;
     /// [`Integrator::dense_state`] written into `out` (shape `[2N]`, the state's length), bit
     /// for bit: the default copies it; the Taylor integrator allocates nothing (the lock-in's
-    /// 32 samples per drive period, [`dense::sample_dense`]).
+    /// 32 samples per drive period, `dense::sample_dense`).
     fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
         out.copy_from_slice(self.dense_state(tau).as_slice());
     }
@@ -233,7 +233,7 @@ pub trait Integrator: Send {
         let _ = on;
     }
     /// Move the sample to the gap α5 = `alpha5` in place, everything else of the model kept (a
-    /// scan's piezo between drive periods, [`crate::analysis::am_loop::scan_line`]), so that
+    /// scan's piezo between drive periods, `crate::analysis::am_loop::scan_line`), so that
     /// after [`Integrator::reset`] the integrator steps as one built by
     /// [`crate::integrate::build`] for the changed model, bit for bit
     /// ([`crate::model::CantileverModel::set_gap`]). `false` (the default, and for an α5 the
@@ -288,8 +288,8 @@ pub trait AffineRegions {
     fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool;
     /// ∂z(τ1)/∂p of the last step [τ0, τ1] inside its region, at fixed z(τ0), τ0 and τ1, written
     /// into `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2,
-    /// α5; [`crate::model::CantileverModel::forcing_derivative`]). With the step Jacobians J
-    /// and the event shifts of [`crate::system::saltation_with_shift`] it gives the parameter
+    /// α5; `crate::model::CantileverModel::forcing_derivative`). With the step Jacobians J
+    /// and the event shifts of `crate::system::saltation_with_shift` it gives the parameter
     /// sensitivity of a flow, s ← J s + this (see
     /// [`crate::maps::flow::flow`]). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it for this step or parameter (the
@@ -304,7 +304,7 @@ pub trait AffineRegions {
     ) -> Result<bool, SimError>;
     /// ∂z_p/∂p(τ) of the periodic particular solution z_p of region `r` (eq. 10), written into
     /// `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2, α5;
-    /// [`crate::model::CantileverModel::forcing_derivative`]). In a region with a transition
+    /// `crate::model::CantileverModel::forcing_derivative`). In a region with a transition
     /// matrix ([`AffineRegions::has_region_transition`]) the flow is z(τ) = z_p(τ) +
     /// e^{A_r t}(z(τ0) − z_p(τ0)) with A_r independent of p, so over a whole stint the
     /// parameter sensitivity telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ)
@@ -350,7 +350,7 @@ pub trait Spans {
     /// the last step of the dense output, [`Integrator::last_step_rate_integrals`] and
     /// [`Integrator::last_step_jacobian`] is the whole span. The default takes one step; the
     /// exact propagator runs the steps of a stint in one loop (`integrate/exact/span.rs`), so
-    /// that a recorder ([`crate::trajectory::record_rows`]) works once per span instead of
+    /// that a recorder (`crate::trajectory::record_rows`) works once per span instead of
     /// once per grid step.
     ///
     /// # Errors
@@ -406,7 +406,7 @@ pub(crate) fn smooth_time(integ: &mut dyn Integrator, a: f64, b: f64, u: f64) ->
 ///
 /// # Errors
 /// As [`Integrator::step`].
-pub fn step_span(
+pub(crate) fn step_span(
     integ: &mut dyn Integrator,
     tau_max: f64,
     body: Option<&BodyContactCheck>,
@@ -419,7 +419,7 @@ pub fn step_span(
 
 /// Form the plain state after [`Spans::step_deferred`] or [`step_span`] (nothing to do for an
 /// integrator without [`Spans`]).
-pub fn form_state(integ: &mut dyn Integrator) {
+pub(crate) fn form_state(integ: &mut dyn Integrator) {
     if let Some(s) = integ.spans() {
         s.form_state();
     }
@@ -427,7 +427,7 @@ pub fn form_state(integ: &mut dyn Integrator) {
 
 /// [`Spans::tip_values`] where the integrator has spans, else [`TipSampleSystem::tip_values`]
 /// of its state.
-pub fn tip_values(integ: &mut dyn Integrator) -> [f64; 4] {
+pub(crate) fn tip_values(integ: &mut dyn Integrator) -> [f64; 4] {
     match integ.spans() {
         Some(s) => s.tip_values(),
         None => integ.system().tip_values(integ.tau(), integ.state()),
@@ -497,7 +497,7 @@ impl<'a> Observed<'a> {
     pub fn region(&self) -> Region {
         self.integ.region()
     }
-    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state ([`tip_values`]).
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state (`tip_values`).
     pub fn tip_values(&mut self) -> [f64; 4] {
         tip_values(self.integ)
     }

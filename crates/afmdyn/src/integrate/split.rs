@@ -117,7 +117,7 @@ impl Split {
     /// [`SimError::OutOfRange`] for Ω at an undamped resonance of the free beam and
     /// [`SimError::Budget`] for a free-flight grid beyond its budget (as
     /// [`ExactPropagator::try_new`]).
-    pub fn try_new(
+    pub(crate) fn try_new(
         model: &CantileverModel,
         min_steps_per_period: usize,
         tol: f64,

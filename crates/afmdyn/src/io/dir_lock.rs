@@ -8,7 +8,7 @@
 //! locks the directory is used unlocked ([`DirLock::is_locked`] is false) rather than not at
 //! all.
 //!
-//! A file is written as its temporary sibling `.NAME.partial.EXT` ([`partial_path`]) and
+//! A file is written as its temporary sibling `.NAME.partial.EXT` (`partial_path`) and
 //! renamed into place. A run killed outright (a second Ctrl-C, SIGKILL) leaves that sibling;
 //! the next run on the directory, holding the lock so that no other run is writing it,
 //! removes the stale siblings of its own outputs ([`DirLock::remove_partials`]) — never those
@@ -24,7 +24,7 @@ pub(crate) const LOCK_FILE: &str = ".afmdyn.lock";
 /// The temporary sibling `path` is written as before it is renamed into place:
 /// `DIR/NAME.EXT` → `DIR/.NAME.partial.EXT` (`DIR/.NAME.partial` without an extension; the
 /// extension stays last, for the writers that choose a format by it).
-pub fn partial_path(path: &Path) -> PathBuf {
+pub(crate) fn partial_path(path: &Path) -> PathBuf {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
     path.with_file_name(match path.extension().and_then(|s| s.to_str()) {
         Some(ext) => format!(".{stem}.partial.{ext}"),
@@ -121,7 +121,7 @@ impl DirLock {
         &self.dir
     }
 
-    /// Remove the stale temporary siblings ([`partial_path`]) of `outputs`, the names of the
+    /// Remove the stale temporary siblings (`partial_path`) of `outputs`, the names of the
     /// files a run writes in the directory (`timeseries.npy`, `events.csv`, …), which a run
     /// killed before it could clean up left behind. Call it holding the lock (no other run
     /// is then writing them). Returns the files removed.

@@ -4,14 +4,14 @@
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
 //!   lines skipped). A file larger than [`MAX_CSV_BYTES`], or with a line longer than
-//!   [`super::input::MAX_CSV_LINE_BYTES`] (`/dev/zero`), is refused, and no more is read.
+//!   `super::input::MAX_CSV_LINE_BYTES` (`/dev/zero`), is refused, and no more is read.
 //! - **NPY** (`.npy`, NumPy's `np.save`): a 2-D float64 array (`<f8` or `>f8`, C or Fortran
 //!   order), `[row][column]` as the CSV (the `npyz` crate). The file is at most
 //!   [`MAX_NPY_BYTES`], its header at most [`MAX_NPY_HEADER_BYTES`], and the dtype and shape
 //!   are checked before the values are read.
 //!
 //! Both: at most [`MAX_PIXELS`] × [`MAX_PIXELS`] values, rows of one length, each finite and
-//! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
+//! within ±`MAX_HEIGHT` (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
 //! file and the problem (the row and column of a bad value).
 
 #[cfg(feature = "files")]
@@ -27,7 +27,7 @@ pub use super::caps::{MAX_CSV_BYTES, MAX_NPY_BYTES, MAX_NPY_HEADER_BYTES, MAX_PI
 
 /// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
 /// topography the z piezo follows.
-pub const MAX_HEIGHT: f64 = 1e-5;
+pub(crate) const MAX_HEIGHT: f64 = 1e-5;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.

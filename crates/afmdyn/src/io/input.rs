@@ -3,8 +3,8 @@
 //! here, with a cap per [`InputKind`]. A regular file larger than its cap is refused from its
 //! length before any of it is read; anything else (`/dev/zero`, a pipe) is read through
 //! `Read::take(cap + 1)` and refused once it passes the cap, a kind read line by line also once
-//! a line passes its [`InputKind::line_cap`] (a CSV parser holds a line whole), and a store's
-//! file at its first NUL byte ([`InputKind::refuses_nul`]: `/dev/zero` and a sparse file are
+//! a line passes its `InputKind::line_cap` (a CSV parser holds a line whole), and a store's
+//! file at its first NUL byte (`InputKind::refuses_nul`: `/dev/zero` and a sparse file are
 //! refused at once, before any memory is taken). Every refusal names the file, the cap and the
 //! kind.
 
@@ -32,7 +32,8 @@ pub(crate) const MAX_STORE_BYTES: u64 = 128 * 1024 * 1024 * 1024;
 /// [`crate::request::chart::MAX_CHART_TILE`] (10⁴) cells with
 /// [`crate::request::chart::MAX_CHART_SLOTS`] (64) attractors of at most 1.5 KiB of JSON each,
 /// 0.9 GiB (a PI scan's line of 2 × 4096 pixels takes a few MiB).
-pub const MAX_STORE_LINE_BYTES: u64 = 1024 * 1024 * 1024;
+#[cfg(feature = "files")]
+pub(crate) const MAX_STORE_LINE_BYTES: u64 = 1024 * 1024 * 1024;
 /// Largest ledger of a store read back (`.bifurcation.run.json`, `.chart.run.json`, …), in
 /// bytes: 513 MiB, the largest fingerprint a request stores — a PI scan's holds its sample map,
 /// whose height map of 4096 × 4096 values takes at most the 512 MiB of its CSV
@@ -96,7 +97,8 @@ impl InputKind {
 
     /// The longest line read, in bytes, for a kind read line by line (CSV:
     /// [`MAX_CSV_LINE_BYTES`]; a study's records: [`MAX_STORE_LINE_BYTES`]).
-    pub const fn line_cap(self) -> Option<u64> {
+    #[cfg(feature = "files")]
+    pub(crate) const fn line_cap(self) -> Option<u64> {
         match self {
             InputKind::Overlay
             | InputKind::HeightMapCsv
@@ -109,7 +111,8 @@ impl InputKind {
 
     /// Whether a NUL byte refuses the file at once: a store afmdyn wrote is text (CSV, JSON)
     /// and never holds one, while `/dev/zero` and a sparse file are nothing else.
-    pub const fn refuses_nul(self) -> bool {
+    #[cfg(feature = "files")]
+    pub(crate) const fn refuses_nul(self) -> bool {
         matches!(
             self,
             InputKind::Store | InputKind::StoreRecords | InputKind::StoreLedger | InputKind::Lock
@@ -133,19 +136,11 @@ impl InputKind {
             InputKind::Lock => "a store's lock",
         }
     }
-
-    /// Whether the kind is CSV, whose lines are bounded by [`MAX_CSV_LINE_BYTES`].
-    pub const fn is_csv(self) -> bool {
-        matches!(
-            self,
-            InputKind::Overlay | InputKind::HeightMapCsv | InputKind::CurveCsv | InputKind::Store
-        )
-    }
 }
 
 /// An input file opened by [`open`]: its bytes, at most the kind's cap (and, for kinds read
-/// line by line, lines of at most [`InputKind::line_cap`]; for a store, no NUL byte:
-/// [`InputKind::refuses_nul`]); past either, a read fails with an
+/// line by line, lines of at most `InputKind::line_cap`; for a store, no NUL byte:
+/// `InputKind::refuses_nul`); past either, a read fails with an
 /// [`std::io::Error`] carrying the [`InputFileError`] ([`refusal`] finds it).
 #[cfg(feature = "files")]
 #[derive(Debug)]
@@ -161,7 +156,7 @@ pub struct Bounded {
 impl Bounded {
     /// The bounded read of `file`, opened from `path` (which the refusals name) as `kind`; a
     /// caller that opens the file itself checks its length first, as [`open`] does.
-    pub fn new(file: std::fs::File, path: &std::path::Path, kind: InputKind) -> Bounded {
+    pub(crate) fn new(file: std::fs::File, path: &std::path::Path, kind: InputKind) -> Bounded {
         Bounded {
             file: file.take(kind.cap() + 1),
             path: path.display().to_string(),
@@ -361,7 +356,7 @@ pub enum InputFileError {
         /// What the file was read as ([`InputKind::name`], or "this input").
         kind: &'static str,
     },
-    /// A line of a file read line by line is longer than its kind's [`InputKind::line_cap`].
+    /// A line of a file read line by line is longer than its kind's `InputKind::line_cap`.
     #[error(
         "{path}: larger than {limit} bytes in one line, the line limit of {kind} (is it the right \
          file?)"
@@ -374,7 +369,7 @@ pub enum InputFileError {
         /// What the file was read as ([`InputKind::name`]).
         kind: &'static str,
     },
-    /// A store's file holds a NUL byte ([`InputKind::refuses_nul`]): it is not what afmdyn
+    /// A store's file holds a NUL byte (`InputKind::refuses_nul`): it is not what afmdyn
     /// wrote (`/dev/zero`, a sparse or binary file).
     #[error(
         "{path}: a NUL byte after {offset} bytes: not {kind} (text of at most {limit} bytes; is \

@@ -1,12 +1,12 @@
 //! The library's files below every request: the one bounded reader of input files
-//! ([`input`]: a cap per [`InputKind`]), the lock of an output directory ([`dir_lock`], feature
+//! (`input`: a cap per [`InputKind`]), the lock of an output directory ([`dir_lock`], feature
 //! `files`) and the height map files of a sample map ([`height_map`]).
 //!
 //! This module knows no request, analysis, report, study or probe: those import it (a probe
 //! file is read by [`input::read_text`], a study's store is locked by [`dir_lock::DirLock`]),
 //! never the other way round.
 
-pub mod caps;
+pub(crate) mod caps;
 #[cfg(feature = "files")]
 pub mod curve_file;
 #[cfg(feature = "files")]

@@ -1,8 +1,8 @@
 //! Files written atomically: every finished file goes to a temporary name in the same
 //! directory and is renamed into place, so a partial file is never mistaken for a finished one
 //! (a [`Stream`] dropped unfinished removes its temporary file), and every I/O error names its
-//! path ([`FileError`]). The tables: streamed CSV ([`csv_stream`], [`csv_line`] with every
-//! number in its shortest round-trip form, [`f`]) and streamed 2-D float64 NPY arrays
+//! path ([`FileError`]). The tables: streamed CSV (`csv_stream`, `csv_line` with every
+//! number in its shortest round-trip form, `f`) and streamed 2-D float64 NPY arrays
 //! ([`NpyStream`], the NPY format of numpy's `format.py`, byte for byte `npyz`'s writer) with
 //! their self-describing header files (`X.npy.json`: shape, dtype, each column's unit and
 //! meaning, [`Column`]).
@@ -49,7 +49,7 @@ pub(crate) fn temp_path(path: &Path) -> PathBuf {
 ///
 /// # Errors
 /// What `write` returns; a [`FileError`] (converted) when the file cannot be renamed.
-pub fn atomic<F, E>(path: &Path, write: F) -> Result<(), E>
+pub(crate) fn atomic<F, E>(path: &Path, write: F) -> Result<(), E>
 where
     F: FnOnce(&Path) -> Result<(), E>,
     E: From<FileError>,
@@ -84,7 +84,7 @@ pub struct Stream<W> {
 
 impl<W> Stream<W> {
     /// Open `path`'s temporary file and wrap the buffered file with `make`.
-    pub fn create(
+    pub(crate) fn create(
         path: &Path,
         make: impl FnOnce(BufWriter<File>) -> std::io::Result<W>,
     ) -> Result<Self, FileError> {
@@ -132,7 +132,7 @@ impl<W> Drop for Stream<W> {
 pub(crate) type CsvStream = Stream<csv::Writer<BufWriter<File>>>;
 
 /// Start a streamed CSV table with its header row.
-pub fn csv_stream(path: &Path, header: &[&str]) -> Result<CsvStream, FileError> {
+pub(crate) fn csv_stream(path: &Path, header: &[&str]) -> Result<CsvStream, FileError> {
     let mut s = Stream::create(path, |f| Ok(csv::Writer::from_writer(f)))?;
     s.get()
         .write_record(header)
@@ -141,7 +141,7 @@ pub fn csv_stream(path: &Path, header: &[&str]) -> Result<CsvStream, FileError> 
 }
 
 /// Append one row to a streamed CSV table.
-pub fn csv_row<I, T>(s: &mut CsvStream, row: I) -> Result<(), FileError>
+pub(crate) fn csv_row<I, T>(s: &mut CsvStream, row: I) -> Result<(), FileError>
 where
     I: IntoIterator<Item = T>,
     T: AsRef<[u8]>,
@@ -175,25 +175,6 @@ pub fn write_csv(
     csv_finish(s)
 }
 
-/// A table of numbers written atomically (as [`write_csv`] with [`f`] of each value).
-pub fn write_csv_numbers<const C: usize>(
-    path: &Path,
-    header: &[&str],
-    rows: impl IntoIterator<Item = [f64; C]>,
-) -> Result<(), FileError> {
-    let mut s = csv_stream(path, header)?;
-    let mut buf = Vec::with_capacity(1 << 16);
-    for r in rows {
-        csv_line(&mut buf, r.map(Field::Num));
-        if buf.len() >= 1 << 16 {
-            csv_lines(&mut s, &buf)?;
-            buf.clear();
-        }
-    }
-    csv_lines(&mut s, &buf)?;
-    csv_finish(s)
-}
-
 /// One column of a numeric table, as documented in its header file.
 #[derive(Debug, Clone, Serialize)]
 pub struct Column {
@@ -207,7 +188,11 @@ pub struct Column {
 
 impl Column {
     /// A column.
-    pub fn new(name: impl Into<String>, unit: &'static str, meaning: impl Into<String>) -> Self {
+    pub(crate) fn new(
+        name: impl Into<String>,
+        unit: &'static str,
+        meaning: impl Into<String>,
+    ) -> Self {
         Column {
             name: name.into(),
             unit,
@@ -248,7 +233,7 @@ pub struct NpyStream {
 }
 
 /// The open file of an [`NpyStream`] and its buffer of encoded values.
-pub struct NpyFile {
+pub(crate) struct NpyFile {
     file: BufWriter<File>,
     buf: Vec<u8>,
 }
@@ -379,7 +364,7 @@ impl NpyStream {
 /// (several times faster than the standard library's; a spectrum writes a million of them;
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
 /// notation (|v| near 1e-5), the standard formatting is used.
-pub fn f(v: f64) -> String {
+pub(crate) fn f(v: f64) -> String {
     let mut out = Vec::with_capacity(24);
     f_into(&mut out, v);
     String::from_utf8(out).expect("ASCII")
@@ -415,7 +400,7 @@ pub(crate) fn f_into(out: &mut Vec<u8>, v: f64) {
 /// A row of numbers (and words without commas, quotes or line breaks, which CSV writes as
 /// they are) appended to `out` as [`csv_row`] writes it: fields joined by commas, ended by a
 /// newline.
-pub fn csv_line<'a>(out: &mut Vec<u8>, fields: impl IntoIterator<Item = Field<'a>>) {
+pub(crate) fn csv_line<'a>(out: &mut Vec<u8>, fields: impl IntoIterator<Item = Field<'a>>) {
     for (i, field) in fields.into_iter().enumerate() {
         if i > 0 {
             out.push(b',');
@@ -433,14 +418,14 @@ pub fn csv_line<'a>(out: &mut Vec<u8>, fields: impl IntoIterator<Item = Field<'a
 
 /// A field of [`csv_line`].
 #[derive(Debug, Clone, Copy)]
-pub enum Field<'a> {
+pub(crate) enum Field<'a> {
     /// A number, formatted by [`f`].
     Num(f64),
     /// A word written as it is.
     Word(&'a str),
 }
 
-/// Append the lines in `bytes` (whole rows, from [`csv_line`]) to a streamed CSV table.
+/// Append the lines in `bytes` (whole rows, from `csv_line`) to a streamed CSV table.
 pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), FileError> {
     // the csv writer's own buffer is written out first, so that the rows stay in order
     if bytes.is_empty() {

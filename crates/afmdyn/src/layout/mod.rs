@@ -95,7 +95,7 @@ pub struct Variable {
 
 impl Variable {
     /// A variable of `values` over `dims` with no further attributes.
-    pub fn new(
+    pub(crate) fn new(
         name: &str,
         dims: &[&str],
         units: &str,
@@ -113,7 +113,7 @@ impl Variable {
     }
 
     /// A float variable.
-    pub fn f64(
+    pub(crate) fn f64(
         name: &str,
         dims: &[&str],
         units: &str,
@@ -124,7 +124,7 @@ impl Variable {
     }
 
     /// An integer variable.
-    pub fn i32(
+    pub(crate) fn i32(
         name: &str,
         dims: &[&str],
         units: &str,
@@ -154,7 +154,11 @@ pub struct Layout {
 
 impl Layout {
     /// A layout of `variables` over `dims`.
-    pub fn new(title: impl Into<String>, dims: &[(&str, usize)], variables: Vec<Variable>) -> Self {
+    pub(crate) fn new(
+        title: impl Into<String>,
+        dims: &[(&str, usize)],
+        variables: Vec<Variable>,
+    ) -> Self {
         Layout {
             title: title.into(),
             dims: dims.iter().map(|(n, l)| (n.to_string(), *l)).collect(),

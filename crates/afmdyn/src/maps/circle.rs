@@ -36,7 +36,7 @@ use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
 /// The most nodes a circle takes (its cost is that many drive periods per Newton iteration).
-pub const MAX_NODES: usize = 1000;
+pub(crate) const MAX_NODES: usize = 1000;
 
 /// The nodes of an invariant circle: their phases and the interpolation's weights.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,7 +79,7 @@ impl CircleNodes {
     /// [`SimError::OutOfRange`] for M outside 1..=[`MAX_NODES`] or q = 0;
     /// [`SimError::NoConvergence`] when the nodes are too close together for the interpolation
     /// (two nodes at one phase before the period closes).
-    pub fn new(p: u64, q: u64, m: usize) -> Result<Self, SimError> {
+    pub(crate) fn new(p: u64, q: u64, m: usize) -> Result<Self, SimError> {
         if q == 0 {
             return Err(SimError::out_of_range("q", 0, "must be ≥ 1"));
         }
@@ -152,7 +152,7 @@ impl CircleNodes {
 /// [0; a_1, a_2, …]: the first M multiples of ρ then leave at most three gap lengths around
 /// the circle and lie nearly evenly, Khinchin, *Continued Fractions*, 1964, §6), at most
 /// [`MAX_NODES`] and at most q.
-pub fn node_count(p: u64, q: u64, target: usize) -> usize {
+pub(crate) fn node_count(p: u64, q: u64, target: usize) -> usize {
     let (p, q) = (p % q.max(1), q.max(1));
     let target = target as u64;
     if q <= target {
@@ -196,7 +196,7 @@ pub struct Segment {
 /// The circle's map over an integrator (module docs): G(x_0) = x_0 + x_M − Σ_j w_j x_j, whose
 /// fixed point is the circle's node at θ = 0. One iterate integrates M drive periods from
 /// τ = 0; only n = 1 iterate is defined.
-pub struct CircleMap<'a> {
+pub(crate) struct CircleMap<'a> {
     integ: &'a mut dyn Integrator,
     nodes: CircleNodes,
     /// The last linearised segment ([`DiscreteMap::linearise`] keeps it: a Newton solve ends
@@ -208,17 +208,12 @@ pub struct CircleMap<'a> {
 impl<'a> CircleMap<'a> {
     /// The circle's map on `nodes` over `integ` (at its system's parameters; the drive period
     /// T = 2π/Ω of the primary drive).
-    pub fn new(integ: &'a mut dyn Integrator, nodes: CircleNodes) -> Self {
+    pub(crate) fn new(integ: &'a mut dyn Integrator, nodes: CircleNodes) -> Self {
         CircleMap {
             integ,
             nodes,
             last: None,
         }
-    }
-
-    /// The nodes.
-    pub fn nodes(&self) -> &CircleNodes {
-        &self.nodes
     }
 
     /// The primary drive's period T = 2π/Ω (dimensionless τ).
@@ -230,7 +225,7 @@ impl<'a> CircleMap<'a> {
     ///
     /// # Errors
     /// [`SimError`] from the integrator.
-    pub fn segment(&mut self, x0: &DVector<f64>) -> Result<Vec<DVector<f64>>, SimError> {
+    pub(crate) fn segment(&mut self, x0: &DVector<f64>) -> Result<Vec<DVector<f64>>, SimError> {
         let t = self.period();
         let mut xs = vec![x0.clone()];
         for k in 0..self.nodes.len() {
@@ -245,7 +240,7 @@ impl<'a> CircleMap<'a> {
     ///
     /// # Errors
     /// [`SimError`] from the integrator.
-    pub fn linearised_segment(
+    pub(crate) fn linearised_segment(
         &mut self,
         x0: &DVector<f64>,
         grazing: bool,

@@ -57,7 +57,7 @@ pub trait DiscreteMap {
     }
 
     /// Check a state the map is to start from, named `name` in the error. Default:
-    /// [`crate::system::check_state`] (length d, finite entries, ‖z‖ ≤ 1e12).
+    /// `crate::system::check_state` (length d, finite entries, ‖z‖ ≤ 1e12).
     ///
     /// # Errors
     /// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`].

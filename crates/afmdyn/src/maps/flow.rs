@@ -47,7 +47,7 @@ pub struct FlowMap {
 /// Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14) — over a whole stint at once in an
 /// affine region
 /// ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]) — and
-/// s⁺ = S s⁻ + w ∂g/∂p at each event ([`crate::system::saltation_with_shift`]); `None` there
+/// s⁺ = S s⁻ + w ∂g/∂p at each event (`crate::system::saltation_with_shift`); `None` there
 /// when the integrator or the law does not provide it (then ∂z/∂p needs finite differences).
 /// The one loop of every flow with a Jacobian ([`crate::maps::StroboscopicMap::apply`]).
 /// Switches the integrator's variational equations on.
@@ -310,7 +310,7 @@ fn farther(va: f64, vb: f64, d0: f64, nearest: f64) -> bool {
 ///
 /// # Errors
 /// [`SimError`] from the integrator.
-pub fn grazing_distance(
+pub(crate) fn grazing_distance(
     integ: &mut dyn Integrator,
     tau0: f64,
     z0: &DVector<f64>,

@@ -8,14 +8,14 @@
 //! events), the parameter derivative ∂P/∂p (`[2N]`) and the distance to grazing
 //! ([`flow::FlowMap`]). Errors are the integrator's [`SimError`]s.
 //!
-//! - [`discrete`]: the trait [`DiscreteMap`] (image, Jacobian, parameter derivative, distance
+//! - `discrete`: the trait [`DiscreteMap`] (image, Jacobian, parameter derivative, distance
 //!   to grazing of the n-th iterate), which the map-only analyses take;
 //! - [`flow`]: the flow map z(τ0) ↦ z(τ1) of any integrator with its Jacobian (step Jacobians
 //!   times saltation matrices), its parameter derivative and the distance to grazing — the one
 //!   loop every map and the Lyapunov spectrum use;
-//! - [`circle`]: [`circle::CircleMap`], the invariant circle of a two-frequency drive's
+//! - `circle`: `circle::CircleMap`, the invariant circle of a two-frequency drive's
 //!   stroboscopic map as the fixed point of a map (quasi-periodic steady states);
-//! - [`stroboscopic`]: [`StroboscopicMap`], the value the analyses iterate: steady states and
+//! - `stroboscopic`: [`StroboscopicMap`], the value the analyses iterate: steady states and
 //!   period detection ([`crate::analysis::steady`], [`crate::analysis::settle`]), Newton
 //!   shooting and Floquet multipliers ([`crate::analysis::shooting`]), continuation
 //!   ([`crate::analysis::continuation`]) and the stepped curves' fixed-point checks.
@@ -23,10 +23,10 @@
 //! [`Integrator`]: crate::integrate::Integrator
 //! [`SimError`]: crate::error::SimError
 
-pub mod circle;
-pub mod discrete;
+pub(crate) mod circle;
+pub(crate) mod discrete;
 pub mod flow;
-pub mod stroboscopic;
+pub(crate) mod stroboscopic;
 
 pub use discrete::DiscreteMap;
 pub use stroboscopic::StroboscopicMap;

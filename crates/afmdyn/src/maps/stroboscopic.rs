@@ -23,7 +23,7 @@ use nalgebra::DVector;
 /// * [`StroboscopicMap::grazing_distance`]: the distance to grazing alone.
 ///
 /// Every call restarts the integrator at τ = 0 from the given state. The integrator is the
-/// caller's ([`StroboscopicMap::new`]) or the map's own ([`StroboscopicMap::build`]).
+/// caller's ([`StroboscopicMap::new`]) or the map's own (`StroboscopicMap::build`).
 pub struct StroboscopicMap<'a> {
     integ: Held<'a>,
     periods: usize,
@@ -44,7 +44,7 @@ impl StroboscopicMap<'static> {
     ///
     /// # Errors
     /// As [`crate::integrate::build`].
-    pub fn build(
+    pub(crate) fn build(
         model: &CantileverModel,
         opts: IntegratorOptions,
         z: &DVector<f64>,

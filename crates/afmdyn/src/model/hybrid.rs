@@ -76,7 +76,7 @@ impl HybridSystem for CantileverModel {
 
     /// Switchings are the identity; the impact law's free-flight guard is an impact (module
     /// docs), ending in sticking (a plastic impact) when the bounce would rise less than
-    /// [`STICK_HEIGHT_TOLERANCES`] guard tolerances against λ > 0; sticking ends in a release
+    /// `STICK_HEIGHT_TOLERANCES` guard tolerances against λ > 0; sticking ends in a release
     /// (identity).
     fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
         let Some(r) = self.law.law().restitution() else {

@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, DVector};
 /// One rate of the energy balance as zᵀQz + (l₀ + l_s s + l_c c)ᵀz + k₀ + k_s s + k_c c +
 /// k_ss s² + k_sc s c + k_cc c², with (s, c) = (sin Ωτ, cos Ωτ) and z = (a, ȧ) of length 2N.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RateForm {
+pub(crate) struct RateForm {
     /// Q, 2N×2N, symmetric.
     pub q: DMatrix<f64>,
     /// l₀, l_s, l_c, each shape `[2N]`.
@@ -52,7 +52,8 @@ impl RateForm {
     }
 
     /// The rate at (sin Ωτ, cos Ωτ) = `sc` and z.
-    pub fn eval(&self, sc: (f64, f64), z: &[f64]) -> f64 {
+    #[cfg(test)]
+    fn eval(&self, sc: (f64, f64), z: &[f64]) -> f64 {
         let zv = DVector::from_column_slice(z);
         let mut l = vec![0.0; z.len()];
         self.linear_at(sc, &mut l);

@@ -32,7 +32,7 @@ impl CantileverModel {
     /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
     /// motion by Ȧᵀ gives dE/dτ = P_base − D_beam − D_contact exactly, with
     /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c (plus the power F̃(τ) Ẇ(1,τ) of the further
-    /// components of a multifrequency drive, [`Params::component_force`]) and D_contact = F_d δ̇ (F_d the dissipative part
+    /// components of a multifrequency drive, `Params::component_force`) and D_contact = F_d δ̇ (F_d the dissipative part
     /// of the law).
     pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
         let n = self.modes();
@@ -66,7 +66,7 @@ impl CantileverModel {
     /// kinetic energy of the motion relative to the sample changes by −(1 − r²) ½ m_eff (V̇_T⁻)²;
     /// the impulse P = −(1 + r) m_eff V̇_T⁻ at the tip also does the work −P α2 Ω cos Ωτ, so
     /// ΔE = −loss + base (derivation in `docs/contact-laws.md`).
-    pub fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
+    pub(crate) fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
         let p = &self.params;
         let base_velocity = p.base_amplitude() * p.omega * (p.omega * tau).cos();
         let loss = 0.5 * (1.0 - restitution * restitution) * self.m_eff * v_minus * v_minus;
@@ -88,7 +88,7 @@ impl CantileverModel {
     }
 
     /// [`CantileverModel::free_tip_response`] H and its derivative dH/dα3 in the lever's
-    /// damping α3 ([`crate::galerkin::Galerkin::damping_derivative`]): differentiating
+    /// damping α3 (`crate::galerkin::Galerkin::damping_derivative`): differentiating
     /// D X = F with D = K − Ω²M + iΩC, dX/dα3 = D⁻¹(dF/dα3 − iΩ diag(s) X), and
     /// dH = φ(1)ᵀ dX e^{−iψ}. The free amplitude set by an instrument fixes |H| α2; with α3
     /// moving, α2 follows as 1/|H| (d|H|/dα3 = Re(H̄ dH/dα3)/|H|).
@@ -217,7 +217,7 @@ impl CantileverModel {
     /// The free region's ∂f/∂α3 in the lever's damping α3 (eq. 12, eq. 14): the state's rate
     /// (ȧ, M⁻¹(F(τ) − C ȧ − K a)) moves by (0, M⁻¹(∂F/∂α3(τ) − diag(s) ȧ)). `None` when M
     /// is not positive definite.
-    pub fn damping_derivative(&self) -> Option<DampingDerivative> {
+    pub(crate) fn damping_derivative(&self) -> Option<DampingDerivative> {
         let (s, df) = self.galerkin.damping_derivative();
         let n = self.modes();
         let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
@@ -239,7 +239,7 @@ impl CantileverModel {
     /// ∂b/∂p of the free and the contact region (in that order) for a parameter p that enters
     /// the forcing only: b = (0, M⁻¹F) lifted from [`Galerkin::forcing_derivative`] (Ω, α2,
     /// α5); `None` for α1, α3, α4, α6, on which A_s depends.
-    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[ForcingDerivative; 2]> {
+    pub(crate) fn forcing_derivative(&self, param: SweepParam) -> Option<[ForcingDerivative; 2]> {
         let df = self.galerkin.forcing_derivative(param)?;
         let n = self.modes();
         let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;

@@ -105,7 +105,7 @@ pub struct MediumReport {
     /// The first mode's natural frequency in the medium (Hz), as the model has it.
     pub resonance_frequency: f64,
     /// The first mode's quality factor in the medium, 1/(2ζ) of the model's damped eigenvalue
-    /// ([`crate::eigen::quality_factors`]; `None` when it is overdamped).
+    /// (`crate::eigen::quality_factors`; `None` when it is overdamped).
     pub quality_factor: Option<f64>,
     /// Each mode of the model in the fluid.
     pub modes: Vec<FluidMode>,

@@ -82,7 +82,7 @@
 //! A multifrequency drive (`[drive]` arrays) adds, for every model, components F̃ᵢ cos(ωᵢτ) at
 //! the tip ([`crate::params::DriveComponent`]): ωᵢ/Ω is the fraction p/q with the smallest
 //! q ≤ 1000 within 1e-6 of fᵢ/f₁ ([`rational_ratio`]: a periodic drive), else the convergent
-//! of fᵢ/f₁ with q ≤ 10⁶ ([`convergent`]: a quasi-periodic drive, within about 1e-12, whose
+//! of fᵢ/f₁ with q ≤ 10⁶ (`convergent`: a quasi-periodic drive, within about 1e-12, whose
 //! response the time average measures); the frequency used is reported; and
 //! F̃ᵢ = A₀ᵢ/(g₀|Hᵢ|) from the free tip response Hᵢ to a unit tip force at ωᵢ
 //! ([`crate::CantileverModel::free_force_response`]).
@@ -118,7 +118,7 @@
 mod medium;
 pub mod ranges;
 mod reader;
-pub use medium::{CalibratedIn, FluidMode, MediumReport};
+pub(crate) use medium::MediumReport;
 use reader::*;
 
 pub use crate::contact::VACUUM_PERMITTIVITY;
@@ -132,7 +132,7 @@ use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
 /// The convergent of `r` with the largest denominator ≤ `max_q` (defined with the ratio limits in
 /// [`crate::params`], where the time average of a stepped curve also finds it).
-pub use crate::params::convergent_within;
+pub(crate) use crate::params::convergent_within;
 use crate::params::{
     DriveComponent, Excitation, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES,
     MAX_RATIO_DENOMINATOR,
@@ -280,13 +280,13 @@ pub struct Probe {
     /// Rest tip–sample distance z_c (m).
     pub z_c: f64,
     /// Whether the file gives `[sample] z_c` (else z_c is its default A₀; a resonance curve
-    /// then defaults to the free resonance, [`crate::request::curves::free_resonance_base`]).
+    /// then defaults to the free resonance, `crate::request::curves::free_resonance_base`).
     #[serde(skip)]
     pub z_c_in_file: bool,
     /// The fluid of `[medium]` and each mode's loading (`None` without the section).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumReport>,
-    /// The Tabor parameter μ of a DMT, electrostatic or JKR sample ([`tabor_parameter`]; `None`
+    /// The Tabor parameter μ of a DMT, electrostatic or JKR sample (`tabor_parameter`; `None`
     /// for the other laws).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tabor_parameter: Option<f64>,
@@ -297,7 +297,7 @@ pub struct Probe {
     pub input_warnings: Vec<String>,
     /// The tip radius R (m) of a law whose contact is Hertz's paraboloid (hertz, dmt,
     /// electrostatic, jkr, capillary; `None` for the others: linear and SLS springs, impact):
-    /// what [`Probe::indentation_warnings`] holds an indentation against.
+    /// what `Probe::indentation_warnings` holds an indentation against.
     #[serde(skip)]
     pub tip_radius: Option<f64>,
     /// Whether `[drive] mode = "off-resonance"` (PeakForce tapping): then
@@ -326,11 +326,11 @@ pub enum ProbeNeeds {
     Oscillation,
     /// Tapping: the lever driven near a resonance at its free amplitude A₀ (an approach
     /// curve, FM, bimodal, an AM image), which a probe of `[drive] mode = "off-resonance"`
-    /// (PeakForce tapping) does not have ([`Probe::serves`]).
+    /// (PeakForce tapping) does not have (`Probe::serves`).
     Tapping,
     /// A quasi-static force curve: the spring constant, the tip and the sample only. The
     /// resonance, Q, `model` and `[drive]` a file omits are stood in for by
-    /// [`STATIC_STAND_INS`] and named in [`Probe::assumed`].
+    /// `STATIC_STAND_INS` and named in [`Probe::assumed`].
     Static,
 }
 
@@ -338,7 +338,7 @@ pub enum ProbeNeeds {
 /// key (`section.key`, `model` at the root) and TOML value. Nothing quasi-static reads them;
 /// they are typical values (a 50 kHz point-mass lever of Q 100 at 10 nm) only so that the
 /// probe resolves.
-pub const STATIC_STAND_INS: [(&str, f64); 3] = [
+pub(crate) const STATIC_STAND_INS: [(&str, f64); 3] = [
     ("cantilever.resonance_frequency", 50e3),
     ("cantilever.quality_factor", 100.0),
     ("drive.free_amplitude", 10e-9),
@@ -377,14 +377,14 @@ pub struct SampleInputs {
 /// Hertz, DMT and JKR no longer describes a spherical tip: the paraboloid approximates the
 /// sphere for contact radii a = √(Rδ) ≪ R (Johnson, *Contact Mechanics*, 1985, §4.2), and at
 /// δ = R/2 the contact radius is already 0.7 R (and a real tip's apex turns conical).
-pub const INDENTATION_VALIDITY: f64 = 0.5;
+pub(crate) const INDENTATION_VALIDITY: f64 = 0.5;
 
 /// Above this Tabor parameter the contact is JKR's (Johnson & Greenwood, *J. Colloid Interface
 /// Sci.* 192 (1997) 326, adhesion map: DMT below 0.1, the transition between, JKR above 5).
-pub const TABOR_JKR: f64 = 5.0;
+pub(crate) const TABOR_JKR: f64 = 5.0;
 
 /// Below this Tabor parameter the contact is DMT's (Johnson & Greenwood 1997).
-pub const TABOR_DMT: f64 = 0.1;
+pub(crate) const TABOR_DMT: f64 = 0.1;
 
 /// The surface tension of water at 25 °C, 0.07197 N/m (CRC Handbook of Chemistry and Physics,
 /// 97th ed. 2016, "Surface tension of common liquids"): the capillary law's default.
@@ -393,7 +393,7 @@ pub const WATER_SURFACE_TENSION: f64 = 0.07197;
 /// The work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
 /// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
 /// 2011, §13.6).
-pub fn work_of_adhesion(hamaker: f64, z0: f64) -> f64 {
+pub(crate) fn work_of_adhesion(hamaker: f64, z0: f64) -> f64 {
     hamaker / (12.0 * std::f64::consts::PI * z0 * z0)
 }
 
@@ -402,7 +402,7 @@ pub fn work_of_adhesion(hamaker: f64, z0: f64) -> f64 {
 /// E* (Pa) and work of adhesion W (J/m², e.g. [`work_of_adhesion`]) at the equilibrium
 /// separation z₀ (m): which contact model applies — DMT (stiff, weakly adhesive, small tips)
 /// below [`TABOR_DMT`], JKR (compliant, adhesive, large tips) above [`TABOR_JKR`].
-pub fn tabor_parameter(radius: f64, e_star: f64, work: f64, z0: f64) -> f64 {
+pub(crate) fn tabor_parameter(radius: f64, e_star: f64, work: f64, z0: f64) -> f64 {
     (radius * work * work / (e_star * e_star * z0 * z0 * z0)).cbrt()
 }
 
@@ -410,7 +410,7 @@ impl Probe {
     /// A result's validity against the contact law's assumptions: a warning when its largest
     /// indentation `indentation` (m) exceeds [`INDENTATION_VALIDITY`] × the tip radius of a
     /// paraboloid (Hertz-family) contact.
-    pub fn indentation_warnings(&self, indentation: f64) -> Vec<String> {
+    pub(crate) fn indentation_warnings(&self, indentation: f64) -> Vec<String> {
         match self.tip_radius {
             Some(r) if indentation > INDENTATION_VALIDITY * r => vec![format!(
                 "the largest indentation, {} m, exceeds half the tip radius R = {} m: the \
@@ -429,7 +429,7 @@ impl Probe {
 
     /// The probe's own warnings, which every document of it carries
     /// ([`crate::report::with_si`]): a DMT or electrostatic sample in JKR's regime (Tabor
-    /// parameter above [`TABOR_JKR`]), where DMT misses the contact's neck and the adhesion
+    /// parameter above `TABOR_JKR`), where DMT misses the contact's neck and the adhesion
     /// hysteresis.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = self.input_warnings.clone();
@@ -484,7 +484,7 @@ pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
 /// with such a denominator, |r − p/q| < 1/(q q′) with q′ > 10⁶ the next convergent's
 /// denominator (Khinchin, *Continued Fractions*, 1964, Thm. 9), so within about 1e-12 of r
 /// unless r itself has a small denominator. `None` for r outside (0, 10⁶) or not finite.
-pub fn convergent(r: f64) -> Option<(u32, u32)> {
+pub(crate) fn convergent(r: f64) -> Option<(u32, u32)> {
     convergent_within(r, MAX_RATIO_DENOMINATOR)
 }
 
@@ -572,7 +572,7 @@ impl<'a> ProbeSource<'a> {
     }
 
     /// How errors name the source: the path, `<string>` or `<table>`.
-    pub fn origin(&self) -> String {
+    pub(crate) fn origin(&self) -> String {
         match self {
             #[cfg(feature = "files")]
             ProbeSource::Path(p) => p.display().to_string(),
@@ -592,7 +592,7 @@ impl Probe {
     ///
     /// # Errors
     /// [`ProbeError::Io`] for a file that cannot be read; as [`Probe::parse`], naming the
-    /// source ([`ProbeSource::origin`]); [`ProbeError::Invalid`] for a cantilever name that is
+    /// source (`ProbeSource::origin`); [`ProbeError::Invalid`] for a cantilever name that is
     /// not in the library or a `cantilever` key that is not a table.
     pub fn source_text(
         source: ProbeSource<'_>,
@@ -661,7 +661,7 @@ impl Probe {
     }
 
     /// As [`Probe::parse`], for a request that uses what `needs` says
-    /// ([`Probe::from_table_for`]).
+    /// (`Probe::from_table_for`).
     ///
     /// # Errors
     /// As [`Probe::parse`].
@@ -697,7 +697,7 @@ impl Probe {
     ///
     /// # Errors
     /// As [`Probe::from_table`].
-    pub fn from_table_for(
+    pub(crate) fn from_table_for(
         root: &toml::Table,
         origin: &str,
         needs: ProbeNeeds,
@@ -739,7 +739,11 @@ impl Probe {
     ///
     /// # Errors
     /// [`crate::error::SimError::OutOfRange`] naming `drive.mode`.
-    pub fn serves(&self, name: &str, needs: ProbeNeeds) -> Result<(), crate::error::SimError> {
+    pub(crate) fn serves(
+        &self,
+        name: &str,
+        needs: ProbeNeeds,
+    ) -> Result<(), crate::error::SimError> {
         if needs == ProbeNeeds::Tapping && self.off_resonance {
             return Err(crate::error::SimError::out_of_range(
                 "drive.mode",

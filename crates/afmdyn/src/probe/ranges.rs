@@ -1,4 +1,4 @@
-//! The one declaration of every SI input's ranges ([`SI_RANGES`]), by its probe key: the
+//! The one declaration of every SI input's ranges (`SI_RANGES`), by its probe key: the
 //! physical range, outside which a value is refused, and the typical range of AFM probes and
 //! samples, outside which it is accepted with a warning naming the likely unit slip. The probe
 //! reader, the FM request and the Sader–Jarvis reconstruction (whose constants are the probe's
@@ -24,7 +24,7 @@
 /// written in m (1e9 too large), refused with that hint before it becomes a gap α5 the user
 /// never wrote (issues 27 and 28). The physical range of `[sample] z_c` ([`SI_RANGES`]) and of
 /// the requests' distances ([`crate::request::limits::si_distance`]).
-pub const MAX_SI_DISTANCE: f64 = 1e-4;
+pub(crate) const MAX_SI_DISTANCE: f64 = 1e-4;
 
 /// A bound of a physical range: the value beyond which a value is refused, and the refusal's
 /// words (`{x}` stands for the value as given).
@@ -32,7 +32,7 @@ pub type Bound = (f64, &'static str);
 
 /// The ranges of one SI input (module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SiRange {
+pub(crate) struct SiRange {
     /// The probe file's `[section]`s holding the keys.
     pub sections: &'static [&'static str],
     /// Its keys in the section (more than one where they share the ranges).
@@ -56,7 +56,7 @@ pub struct SiRange {
 }
 
 /// Every SI input with a physical or typical range beyond its sign (module doc).
-pub const SI_RANGES: &[SiRange] = &[
+pub(crate) const SI_RANGES: &[SiRange] = &[
     SiRange {
         sections: &["tip"],
         keys: &["radius"],
@@ -255,7 +255,7 @@ pub(crate) fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
 impl SiRange {
     /// Why `x` is refused (outside the physical range: a unit slip rather than a measurement),
     /// or `None`.
-    pub fn refusal(&self, x: f64) -> Option<String> {
+    pub(crate) fn refusal(&self, x: f64) -> Option<String> {
         let v = if self.magnitude { x.abs() } else { x };
         let words = match (self.below, self.above) {
             (Some((lo, w)), _) if v < lo => w,
@@ -270,7 +270,7 @@ impl SiRange {
     /// the prefix it was likely meant in, when one of [`SiRange::slips`] brings it into the
     /// range (`was it meant in kHz? (300 kHz is 300000 Hz)`), else the unit reminder; `None`
     /// inside the typical range.
-    pub fn warning(&self, x: f64) -> Option<String> {
+    pub(crate) fn warning(&self, x: f64) -> Option<String> {
         let (lo, hi, range, reminder) = self.typical?;
         if (self.zero_typical && x == 0.0) || (lo..=hi).contains(&x) {
             return None;
@@ -292,13 +292,13 @@ impl SiRange {
     }
 }
 
-/// Why `[section].key = x` is refused ([`SiRange::refusal`]), if it is.
+/// Why `[section].key = x` is refused (`SiRange::refusal`), if it is.
 pub fn refusal(section: &str, key: &str, x: f64) -> Option<String> {
     si_range(section, key)?.refusal(x)
 }
 
 /// The typical-range warning of `[section].key = x` ([`SiRange::warning`]), if any.
-pub fn warning(section: &str, key: &str, x: f64) -> Option<String> {
+pub(crate) fn warning(section: &str, key: &str, x: f64) -> Option<String> {
     si_range(section, key)?.warning(x)
 }
 

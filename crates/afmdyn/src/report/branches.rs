@@ -15,7 +15,7 @@ use crate::params::SweepParam;
 /// `grazing_distance` (g₀), `event` (`""` or the located bifurcation), `w_tip_section` (W(1,τ)
 /// at the section points, g₀, from `model`'s tip row), `multipliers` (complex) and `state` (the
 /// section point at τ = 0, (a, ȧ)).
-pub fn continuation_layout(
+pub(crate) fn continuation_layout(
     param: SweepParam,
     model: &CantileverModel,
     branches: &[Branch],

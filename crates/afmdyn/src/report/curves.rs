@@ -7,7 +7,7 @@ use super::*;
 /// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
 /// fraction, min distance, E_dis, virial, THD, the higher modes' participation
 /// √(Σ_{k≥2} A_k²)/A_1 from [`Observables::mode_amplitudes`].
-pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
+pub(crate) fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
     [
         o.amplitude * u.length,
         o.amplitude / o.closed_form.free_amplitude,
@@ -45,7 +45,7 @@ pub fn higher_mode_fraction(amplitudes: &[f64]) -> f64 {
 /// `mode_balance`);
 /// [`crate::analysis::observables::ComponentObservables`]). The `"reported"` block of
 /// `observe`'s document, which Python's dataset is built from.
-pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
+pub(crate) fn observed(o: &Observables, u: &CurveUnits) -> Value {
     let mut m = serde_json::Map::new();
     for (c, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
         m.insert(c.name.into(), json!(v));
@@ -378,13 +378,13 @@ pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Par
 
 /// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
 /// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
-/// [`Params::rest_distance`]) and the [`CURVE_COLUMNS`], plus `stable`, `period` (null when not
+/// [`Params::rest_distance`]) and the `CURVE_COLUMNS`, plus `stable`, `period` (null when not
 /// period-n) and `reached` ([`crate::analysis::stepped::Reached`]); each branch the same
 /// columns with `stable`, `period` and `event` (null, "fold", "grazing", …). Also `folds` and
 /// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
 /// `free_amplitude`, `units` (names), `scales` (the [`CurveUnits`] factors), `params` and
 /// `warnings`.
-pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let x = z_c_of(params, u);
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
 }
@@ -398,7 +398,7 @@ fn z_c_of<'a>(params: &'a Params, u: &'a CurveUnits) -> impl Fn(f64) -> f64 + 'a
 /// The regime of a steady state from its mean deflection ⟨W⟩ (any length unit):
 /// `"attractive"` where the mean tip–sample force, k⟨W⟩ for the point mass, is negative, else
 /// `"repulsive"` (García & San Paulo, *Phys. Rev. B* 61 (2000) R13381).
-pub fn regime(mean_deflection: f64) -> &'static str {
+pub(crate) fn regime(mean_deflection: f64) -> &'static str {
     if mean_deflection < 0.0 {
         "attractive"
     } else {
@@ -411,7 +411,7 @@ pub fn regime(mean_deflection: f64) -> &'static str {
 /// (`points`, [`crate::analysis::setpoint::operating_points`]) its `source` (`"branch k"`,
 /// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
 /// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
-/// [`CURVE_COLUMNS`] of its orbit (interpolated between two time-averaged motions).
+/// `CURVE_COLUMNS` of its orbit (interpolated between two time-averaged motions).
 pub fn setpoint(
     params: &Params,
     c: &SteppedCurve,
@@ -525,7 +525,7 @@ fn around<'a>(
 
 /// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
 /// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
-pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+pub(crate) fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let scale = u.hz_per_omega.unwrap_or(1.0);
     let key = if u.hz_per_omega.is_some() {
         "frequency_hz"

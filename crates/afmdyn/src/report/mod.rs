@@ -35,7 +35,7 @@ pub fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -
     json!({ "params": params, "free": region_spectrum(free), "contact": region_spectrum(contact) })
 }
 
-pub use crate::trajectory::energy_residual;
+pub(crate) use crate::trajectory::energy_residual;
 
 /// What `afmdyn simulate --json` reports of a run (the front ends add their own keys, e.g. the
 /// files written and warnings).
@@ -57,11 +57,11 @@ pub struct SimulateSummary {
 
 /// Relative per-period energy residual above which a run is reported as inaccurate (normal runs
 /// close to ~1e-10 with the exact propagator and with the adaptive integrator's dense output).
-pub const ENERGY_TOLERANCE: f64 = 1e-6;
+pub(crate) const ENERGY_TOLERANCE: f64 = 1e-6;
 
 /// The run's own accuracy checks that failed: the energy balance beyond [`ENERGY_TOLERANCE`],
 /// and the beam body reaching the substrate (outside the paper's model, Fig. 2f).
-pub fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
+pub(crate) fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
     let mut w = vec![];
     let relative = s.energy_residual.1;
     if relative.is_nan() || relative > ENERGY_TOLERANCE {
@@ -83,7 +83,7 @@ pub fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
 
 /// `afmdyn simulate --json`: final time and state, events, body contact, section points, the
 /// energy-balance residual and [`simulate_warnings`].
-pub fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
+pub(crate) fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
     let zf = &s.final_state;
     let n = model.modes();
     json!({
@@ -104,8 +104,8 @@ pub fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
     })
 }
 
-/// [`simulate_summary`] of a whole [`Trajectory`].
-pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
+/// `simulate_summary` of a whole [`Trajectory`].
+pub(crate) fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
     simulate_summary(
         model,
         &SimulateSummary {
@@ -121,7 +121,7 @@ pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
 
 /// `afmdyn converge --json` without the output directory: the parameters and, per N, the
 /// period and the RMS change of the tip motion against N − 1.
-pub fn converge(params: &Params, runs: &[ConvergenceRun]) -> Value {
+pub(crate) fn converge(params: &Params, runs: &[ConvergenceRun]) -> Value {
     let rows: Vec<_> = runs
         .iter()
         .map(|r| json!({ "modes": r.modes, "period": r.period, "rms_change": r.rms_change }))
@@ -145,7 +145,7 @@ pub fn initial_modal(z: Option<&DVector<f64>>) -> String {
 
 /// One attractor of `afmdyn attractors --json`; `multipliers` ([re, im] pairs) and `stable` of
 /// the shooting-polished orbit, null for a nonperiodic motion.
-pub fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> Value {
+pub(crate) fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> Value {
     json!({
         "multipliers": orbit.map(|o| o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
         "stable": orbit.map(|o| o.stable),
@@ -165,7 +165,7 @@ pub fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> 
 }
 
 /// `afmdyn attractors --json` (also written to `attractors.json`): `samples` starts at `params`.
-pub fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> Value {
+pub(crate) fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> Value {
     json!({
         "params": params,
         "samples": samples,
@@ -354,7 +354,7 @@ pub fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
 
 /// `afmdyn continue --json` without the output directory: the branches' sizes and their
 /// located bifurcations.
-pub fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Value {
+pub(crate) fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Value {
     let events: Vec<_> = branches
         .iter()
         .flatten()
@@ -388,7 +388,7 @@ mod curves;
 mod present;
 mod series;
 mod units;
-pub use branches::*;
+pub(crate) use branches::*;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
 pub use curves::*;
@@ -398,7 +398,7 @@ pub use units::*;
 
 /// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
 /// [`LyapunovSpectrum`], so a field added there reaches both front ends).
-pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
+pub(crate) fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
     let mut doc = serde_json::to_value(l).expect("a Lyapunov spectrum serialises");
     doc["params"] = json!(params);
     doc

@@ -109,7 +109,7 @@ impl Presentation {
         });
     }
     /// Add a dataset.
-    pub fn dataset(&mut self, name: &str, layout: Layout) {
+    pub(crate) fn dataset(&mut self, name: &str, layout: Layout) {
         self.files.push(OutputFile::Dataset {
             name: name.to_string(),
             layout,
@@ -221,7 +221,7 @@ pub fn si_prefix(mag: f64, plain: bool) -> (i32, &'static str) {
 /// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits
 /// (13.4747 nm, 300.000 kHz), or plain SI when `plain` (8.033740e-9 m): the one format of SI
 /// values in every text summary.
-pub fn si_value(v: f64, unit: &str, plain: bool) -> String {
+pub(crate) fn si_value(v: f64, unit: &str, plain: bool) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v} {unit}");
     }
@@ -241,7 +241,7 @@ pub fn si_value(v: f64, unit: &str, plain: bool) -> String {
 /// two significant digits, `0.07988 aJ ± 0.00043 aJ` (the rounding convention of the GUM, JCGM
 /// 100:2008 §7.2.6). `None` where the error is not finite and positive, or the values need a
 /// power of ten besides the prefix (plain SI): they print one by one ([`si_value`]) then.
-pub fn si_with_error(
+pub(crate) fn si_with_error(
     v: f64,
     se: f64,
     unit: &str,
@@ -261,7 +261,7 @@ pub fn si_with_error(
 }
 
 /// The units of a text summary: SI with a probe (lengths, frequencies and rates through its
-/// scales, printed by [`si_value`]), else the model's (g₀, Ω, per unit τ).
+/// scales, printed by `si_value`), else the model's (g₀, Ω, per unit τ).
 #[derive(Debug, Clone, Copy)]
 pub struct TextUnits {
     /// The probe's scales (SI), or none (dimensionless).
@@ -278,7 +278,7 @@ impl TextUnits {
             plain,
         }
     }
-    /// `v` in `unit` ([`si_value`] with these units' prefix choice).
+    /// `v` in `unit` (`si_value` with these units' prefix choice).
     pub fn value(self, v: f64, unit: &str) -> String {
         si_value(v, unit, self.plain)
     }

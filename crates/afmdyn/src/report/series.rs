@@ -22,7 +22,7 @@ use nalgebra::DVector;
 /// velocities); the energy balance per period `[C]` (`energy_tau0`, `energy_start`,
 /// `energy_end`, `base_work`, `beam_dissipation`, `contact_dissipation`, `energy_residual`);
 /// `spectrum` `[F]` over the coordinate `frequency` (the amplitude spectrum of W(1,τ) over the
-/// last [`SPECTRUM_SAMPLES`] samples, the command line's `spectrum.csv`); the coordinates
+/// last `SPECTRUM_SAMPLES` samples, the command line's `spectrum.csv`); the coordinates
 /// `mode` (1…N) and `component` (`a_1` … `a_dot_N`).
 pub fn simulate_layout(
     model: &CantileverModel,

@@ -4,7 +4,7 @@
 
 use super::*;
 
-/// Scales of a stepped-curve document ([`approach`], [`resonance`]): the factors that turn the
+/// Scales of a stepped-curve document (`approach`, `resonance`): the factors that turn the
 /// model's lengths (g₀), forces (F̃) and energies (F̃·g₀) into the reported units, and Ω into Hz.
 /// The one place the curves are converted.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,7 +25,7 @@ pub struct CurveUnits {
 
 impl CurveUnits {
     /// The model's own units (every factor 1).
-    pub fn dimensionless() -> Self {
+    pub(crate) fn dimensionless() -> Self {
         CurveUnits {
             length: 1.0,
             force: 1.0,
@@ -256,7 +256,7 @@ pub enum UnitKind {
 impl UnitKind {
     /// The kind's key in a document's `units` block (`length`, `force`, `energy`, `phase`;
     /// `None` for a pure number): how Python's datasets and a document's column lists name it.
-    pub fn key(self) -> Option<&'static str> {
+    pub(crate) fn key(self) -> Option<&'static str> {
         match self {
             UnitKind::Length => Some("length"),
             UnitKind::Force => Some("force"),
@@ -271,7 +271,7 @@ impl UnitKind {
 /// one declaration of the JSON document's keys, the command line's `.npy.json` meanings and
 /// Python's dataset attributes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CurveColumn {
+pub(crate) struct CurveColumn {
     /// The key (`amplitude`, `phase_deg`, …).
     pub name: &'static str,
     /// Its kind of unit.
@@ -289,7 +289,7 @@ const fn curve_column(name: &'static str, kind: UnitKind, long_name: &'static st
 }
 
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
-pub const CURVE_COLUMNS: [CurveColumn; 13] = [
+pub(crate) const CURVE_COLUMNS: [CurveColumn; 13] = [
     curve_column(
         "amplitude",
         UnitKind::Length,
@@ -368,7 +368,7 @@ pub(crate) fn curve_column_index(name: &str) -> Option<usize> {
 /// primary): `amplitude_i`, `phase_i_deg`, `virial_i`, `energy_dissipated_i` (per cycle of
 /// component i), each with its kind of unit and meaning. [`component_row`] gives the values in
 /// this order.
-pub fn component_columns(count: usize) -> Vec<(String, UnitKind, String)> {
+pub(crate) fn component_columns(count: usize) -> Vec<(String, UnitKind, String)> {
     (1..=count)
         .flat_map(|i| {
             [
@@ -401,7 +401,10 @@ pub fn component_columns(count: usize) -> Vec<(String, UnitKind, String)> {
 
 /// The values of [`component_columns`] of one orbit's observables in `u`'s units (empty for a
 /// single-frequency drive).
-pub fn component_row(o: &crate::analysis::observables::Observables, u: &CurveUnits) -> Vec<f64> {
+pub(crate) fn component_row(
+    o: &crate::analysis::observables::Observables,
+    u: &CurveUnits,
+) -> Vec<f64> {
     o.components
         .iter()
         .flat_map(|c| {

@@ -313,7 +313,7 @@ impl Default for AttractorsRequest {
 
 impl AttractorsRequest {
     /// The validated census of `params` ([`AttractorSpec::validate`]; the integrator built for
-    /// [`ATTRACTOR_SAMPLES_PER_PERIOD`]).
+    /// `ATTRACTOR_SAMPLES_PER_PERIOD`).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `samples`, `cluster_tol` or a steady-state option.
@@ -623,7 +623,7 @@ impl ConvergeRequest {
     /// The runs N = 1..=max_modes of `params` (its own N is replaced).
     ///
     /// # Errors
-    /// As [`Self::validate`] and [`crate::analysis::converge::mode_convergence`].
+    /// As [`Self::validate`] and `crate::analysis::converge::mode_convergence`.
     /// Each run is counted in `progress`, which also cancels the whole.
     pub fn run(
         &self,
@@ -750,14 +750,14 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 mod tests;
 
 /// Most drive periods [`advance_from_rest`] integrates.
-pub const MAX_ADVANCE_PERIODS: usize = 1_000_000;
+pub(crate) const MAX_ADVANCE_PERIODS: usize = 1_000_000;
 
 /// The state `z` (shape `[2N]`, (a, ȧ)) after `periods` drive periods from rest, with the
 /// default (`auto`) integrator: the engine's cost per forcing period, which a front end times
 /// (the browser against the native build, `scripts/perf-wasm.sh`).
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] for `periods` outside 1..=[`MAX_ADVANCE_PERIODS`]; the model's
+/// [`SimError::OutOfRange`] for `periods` outside 1..=`MAX_ADVANCE_PERIODS`; the model's
 /// and the integrator's errors.
 pub fn advance_from_rest(params: &Params, periods: usize) -> Result<Vec<f64>, SimError> {
     if !(1..=MAX_ADVANCE_PERIODS).contains(&periods) {

@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// Side of the boxes of the basin entropy, in cells ([`basin_entropy`]; Daza et al. use 5).
-pub const ENTROPY_BOX: usize = 5;
+pub(crate) const ENTROPY_BOX: usize = 5;
 
 /// `basins`: a basin map over two coordinates of the initial state at τ = 0.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -174,9 +174,9 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
 /// The document of a basin map (`afmdyn basins --json`): axes, labels (ny rows of nx ids),
 /// attractors (period, multipliers, stability, λ₁, Poincaré states, X_max, min V_T, contacts),
 /// basin fractions, failed cells, how the cells were decided, the drive periods run, basin
-/// entropy S_b and boundary basin entropy S_bb (boxes of [`ENTROPY_BOX`]² cells; null when no
+/// entropy S_b and boundary basin entropy S_bb (boxes of `ENTROPY_BOX`² cells; null when no
 /// box fits) and the uncertainty exponent (null when no cell is uncertain).
-pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
+pub(crate) fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
     let nx = spec.xs.len();
     let labels = map.labels();
     let entropy = basin_entropy(&labels, nx, ENTROPY_BOX);
@@ -241,7 +241,7 @@ pub(crate) fn csv_text(spec: &BasinSpec, map: &BasinMap) -> String {
 /// The caveats of a basin map (the `warnings` of its document): attractors that are
 /// nonperiodic with λ₁ ≤ 0 — quasi-periodic, or starts still converging at the transient cap
 /// whose cells carry a label that is not an attractor's.
-pub fn warnings(spec: &BasinSpec, map: &BasinMap) -> Vec<String> {
+pub(crate) fn warnings(spec: &BasinSpec, map: &BasinMap) -> Vec<String> {
     let model = CantileverModel::new(&spec.params).ok();
     let cap = model.as_ref().map(|m| spec.steady.cap(m));
     map.attractors
@@ -390,7 +390,7 @@ impl BasinArrays {
     }
 
     /// The arrays of `map`.
-    pub fn new(map: &BasinMap) -> Self {
+    pub(crate) fn new(map: &BasinMap) -> Self {
         let int = |v: usize| i32::try_from(v).unwrap_or(i32::MAX);
         BasinArrays {
             label: map.cells.iter().map(|c| c.label as i32).collect(),

@@ -7,7 +7,7 @@
 //! resolve through [`ModelSpec::resolve`] like a single run's. The chart's cells and tasks are
 //! [`crate::analysis::chart`]'s; this module holds the request, its limits, its fingerprint
 //! (what a resumed chart must match); the one layout of its results is
-//! [`super::chart_layout`]'s ([`ChartArrays`], the variables of `chart.nc` and of Python's
+//! `super::chart_layout`'s ([`ChartArrays`], the variables of `chart.nc` and of Python's
 //! `xarray.Dataset`; [`CSV_HEADER`], the rows of `chart.csv`).
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
@@ -135,7 +135,7 @@ impl Default for ChartRequest {
 /// The chart axes that are values of the probe file (SI): name, TOML section, key, unit. A
 /// cell's probe is the file with that value replaced, resolved again (every scale follows: the
 /// free amplitude A₀ is the length unit g₀).
-pub const PROBE_AXES: [(&str, &str, &str, &str); 5] = [
+pub(crate) const PROBE_AXES: [(&str, &str, &str, &str); 5] = [
     ("free_amplitude", "drive", "free_amplitude", "m"),
     ("sample_modulus", "sample", "youngs_modulus", "Pa"),
     ("quality_factor", "cantilever", "quality_factor", "1"),
@@ -153,7 +153,7 @@ fn probe_axis(
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `field` for a name that is neither a real model parameter
-/// nor one of the probe values of [`PROBE_AXES`].
+/// nor one of the probe values of `PROBE_AXES`.
 pub fn axis_name(field: &'static str, key: &str) -> Result<&'static str, SimError> {
     let key = key.trim().to_ascii_lowercase().replace('-', "_");
     if let Some(a) = probe_axis(&key) {
@@ -182,7 +182,7 @@ pub struct ChartModel {
     pub defaults: Params,
     /// The probe file, if any.
     pub probe: Option<Probe>,
-    /// The probe file's table, when an axis is one of its values ([`PROBE_AXES`]).
+    /// The probe file's table, when an axis is one of its values (`PROBE_AXES`).
     pub probe_table: Option<toml::Table>,
     /// The x parameter's name.
     pub x: &'static str,
@@ -257,7 +257,7 @@ pub struct Chart {
     pub slots: usize,
     /// The cells' parameters.
     pub model: ChartModel,
-    /// What a resumed chart must match ([`fingerprint`]).
+    /// What a resumed chart must match (`fingerprint`).
     pub fingerprint: Value,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
@@ -455,7 +455,7 @@ fn read_probe(probe: Option<&str>) -> Result<(Option<toml::Table>, Option<Probe>
 
 /// The fingerprint of a chart: everything that determines its cells (the library's version,
 /// the model values, the probe, every chart option but the threads).
-pub fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
+pub(crate) fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
     let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
     if let Some(map) = r.as_object_mut() {
         map.remove("threads");
@@ -478,7 +478,7 @@ pub fn axis_unit(name: &str) -> &'static str {
 
 /// The caveats of a chart's answer (the `warnings` of its document): attractors that did not
 /// settle within the transient cap, runs that failed.
-pub fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
+pub(crate) fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
     let mut w = Vec::new();
     use crate::analysis::chart::MotionKind;
     let settling = |c: &&ChartCell| {

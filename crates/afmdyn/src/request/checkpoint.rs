@@ -1,16 +1,14 @@
 //! Checkpoints of a bifurcation sweep: a sweep writes each finished point to a store, and an
 //! interrupted sweep resumes from it, computing exactly the points not yet stored — only when
-//! the request is the one that made the store (its [`fingerprint`]).
+//! the request is the one that made the store (its `fingerprint`).
 //!
 //! A store implements [`Checkpoint`]; [`MemoryCheckpoint`] keeps the records in memory, and
-//! with the `files` feature [`super::checkpoint_file::FileCheckpoint`] keeps them in a
+//! with the `files` feature `super::checkpoint_file::FileCheckpoint` keeps them in a
 //! directory (the command line's `--out` with `--resume`, Python's `store=`).
 //!
 //! [`open`] decides where a sweep stands in its store; the sweep is a study
 //! ([`crate::study::sweep::SweepStudy`]) that [`crate::study::execute`] computes into it, and
-//! [`Checkpoint::finish`] puts the rows in the one order ([`super::sweep::order_key`]).
-//!
-//! [`fingerprint`]: super::sweep::fingerprint
+//! [`Checkpoint::finish`] puts the rows in the one order (`super::sweep::order_key`).
 
 use super::sweep::{first_difference, SweepRecord};
 use crate::analysis::bifurcation::{Branch, Resume, SweepSpec};
@@ -222,13 +220,14 @@ pub struct MemoryCheckpoint {
 
 impl MemoryCheckpoint {
     /// The records, point after point.
-    pub fn into_records(self) -> Vec<SweepRecord> {
+    #[cfg(any(test, feature = "files"))]
+    pub(crate) fn into_records(self) -> Vec<SweepRecord> {
         self.points.into_iter().flatten().collect()
     }
 }
 
 /// The continuation state of a stored point: the state of its last record, unless it failed.
-pub fn end_state(point: &[SweepRecord]) -> Option<DVector<f64>> {
+pub(crate) fn end_state(point: &[SweepRecord]) -> Option<DVector<f64>> {
     point
         .last()
         .filter(|r| r.status != super::sweep::PointStatus::Error && !r.state.is_empty())

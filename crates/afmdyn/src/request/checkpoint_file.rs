@@ -139,8 +139,9 @@ fn corrupt(path: &Path, message: String) -> CheckpointError {
 
 /// A sweep's checkpoint in a directory (see the module), which the caller holds locked.
 #[derive(Debug)]
-pub struct FileCheckpoint<'a> {
-    lock: &'a DirLock,
+pub(crate) struct FileCheckpoint<'a> {
+    /// The lock the store is written under (held for the checkpoint's lifetime).
+    _lock: &'a DirLock,
     dir: PathBuf,
     writer: Option<BufWriter<File>>,
 }
@@ -321,21 +322,16 @@ fn groups(path: &Path) -> Result<Vec<Group>, CheckpointError> {
 impl<'a> FileCheckpoint<'a> {
     /// The store in the directory `lock` holds ([`DirLock::acquire`] creates and locks it, so
     /// that no two runs write one store).
-    pub fn new(lock: &'a DirLock) -> FileCheckpoint<'a> {
+    pub(crate) fn new(lock: &'a DirLock) -> FileCheckpoint<'a> {
         FileCheckpoint {
-            lock,
+            _lock: lock,
             dir: lock.path().to_path_buf(),
             writer: None,
         }
     }
 
-    /// The lock the store is written under.
-    pub fn lock(&self) -> &DirLock {
-        self.lock
-    }
-
     /// The finished rows, `DIR/bifurcation.csv`.
-    pub fn final_csv(&self) -> PathBuf {
+    pub(crate) fn final_csv(&self) -> PathBuf {
         self.dir.join(FINAL_CSV)
     }
 
@@ -350,7 +346,7 @@ impl<'a> FileCheckpoint<'a> {
     ///
     /// # Errors
     /// [`FileError`] naming the file that cannot be read or written.
-    pub fn write_npy(&self, param: SweepParam) -> Result<PathBuf, FileError> {
+    pub(crate) fn write_npy(&self, param: SweepParam) -> Result<PathBuf, FileError> {
         let (csv_path, npy) = (self.final_csv(), self.dir.join("bifurcation.npy"));
         let rd = |e: csv::Error| io_error("read", &csv_path, e);
         let file = crate::io::open(&csv_path, InputKind::Store)
@@ -402,7 +398,7 @@ impl<'a> FileCheckpoint<'a> {
     /// # Errors
     /// [`CheckpointError::Io`], or [`CheckpointError::Corrupt`] naming the line that cannot
     /// be read.
-    pub fn records(&self) -> Result<Vec<SweepRecord>, CheckpointError> {
+    pub(crate) fn records(&self) -> Result<Vec<SweepRecord>, CheckpointError> {
         let path = self.final_csv();
         let file = open_store(&path, InputKind::Store)?.ok_or_else(|| CheckpointError::Io {
             action: "read",

@@ -69,7 +69,7 @@ pub(crate) fn newton_work(params: &Params, period: usize, newton: &ShootingOptio
 ///
 /// # Errors
 /// [`SimError::Budget`] naming the request, its cost and the budget.
-pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
+pub(crate) fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
     check_cost_advising(
         what,
         cost,
@@ -163,7 +163,7 @@ pub(crate) fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Co
 /// ([`super::curves::trace_bytes`]): 2.5, measured 2.27 (872 bytes per point and sample per
 /// period at 2000 samples, 60 and 120 points, 1 and 2 threads, against 384 for 16 periods of 24
 /// bytes: the vectors grow by doubling while a trace is recorded).
-pub const TRACE_GROWTH: f64 = 2.5;
+pub(crate) const TRACE_GROWTH: f64 = 2.5;
 
 /// The cost of a stepped curve (`approach`, `resonance`): every point's steady state (one way,
 /// and back with branches: each value twice), up to `max_branch_points` Newton solves of the
@@ -172,7 +172,7 @@ pub const TRACE_GROWTH: f64 = 2.5;
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
-pub fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
+pub(crate) fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
     let p = &spec.base;
     let points = spec.values.len() as f64;
     let ways = if spec.branches { 2.0 } else { 1.0 };

@@ -95,7 +95,7 @@ type Abscissa<'a> = (&'a str, &'a str, &'a str);
 /// none); with traces, `trace_deflection`, `trace_distance`, `trace_force` over (`trace`,
 /// `trace_time` in drive periods), and `trace_<abscissa>` over `trace`. Every unit is the
 /// document's (`units`), `1` for a pure number.
-pub fn curve_layout(doc: &Value) -> Layout {
+pub(crate) fn curve_layout(doc: &Value) -> Layout {
     let units = &doc["units"];
     let sweeps = if doc.get("approach").is_some() {
         ["approach", "retract"]
@@ -356,7 +356,7 @@ const OBSERVED: [(&str, Option<&str>, &str); 4] = [
 /// `mode_residual` over `mode`; `state` over `state_index`; under a multifrequency drive
 /// `component_amplitude`, `component_phase_deg`, … and `component_ratio` over `component`
 /// (1, 2, …).
-pub fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layout {
+pub(crate) fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layout {
     let r = &doc["reported"];
     let units = &r["units"];
     let scalar = |key: &str, kind: Option<&str>, long: &str| {

@@ -58,7 +58,7 @@ pub struct CurveRequest {
 
 impl Default for CurveRequest {
     /// The defaults of `afmdyn approach` / `resonance` and the Python functions: the command's
-    /// range, [`DEFAULT_CURVE_POINTS`] values, branches continued, [`DEFAULT_TOLERANCE`].
+    /// range, [`DEFAULT_CURVE_POINTS`] values, branches continued, `DEFAULT_TOLERANCE`.
     fn default() -> Self {
         CurveRequest {
             from: None,
@@ -80,7 +80,7 @@ const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 /// [`crate::analysis::traces::MAX_TRACE_PERIODS`] periods of
 /// [`super::limits::TRACE_BYTES_PER_SAMPLE`] bytes a sample (held against
 /// [`super::limits::MAX_TRACE_BYTES`], and part of the curve's [`super::limits::Cost`]).
-pub fn trace_bytes(points: usize, samples: usize) -> f64 {
+pub(crate) fn trace_bytes(points: usize, samples: usize) -> f64 {
     points as f64
         * (crate::analysis::traces::MAX_TRACE_PERIODS * samples) as f64
         * super::limits::TRACE_BYTES_PER_SAMPLE
@@ -91,7 +91,7 @@ impl CurveRequest {
     ///
     /// # Errors
     /// [`SimError::NotFinite`] naming `from`, `to` or `step`.
-    pub fn check_finite(&self) -> Result<(), SimError> {
+    pub(crate) fn check_finite(&self) -> Result<(), SimError> {
         for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
             if let Some(x) = v {
                 crate::error::finite(name, x)?;
@@ -101,7 +101,7 @@ impl CurveRequest {
     }
 
     /// The ends in dimensionless units: the requested ones divided by `unit`, else `default`.
-    pub fn ends(&self, default: (f64, f64), unit: f64) -> (f64, f64) {
+    pub(crate) fn ends(&self, default: (f64, f64), unit: f64) -> (f64, f64) {
         (
             self.from.map_or(default.0, |v| v / unit),
             self.to.map_or(default.1, |v| v / unit),
@@ -112,7 +112,7 @@ impl CurveRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] when both a step and a count are given.
-    pub fn spacing(&self, unit: f64) -> Result<Spacing, SimError> {
+    pub(crate) fn spacing(&self, unit: f64) -> Result<Spacing, SimError> {
         match (self.step, self.points) {
             (Some(h), Some(_)) => Err(SimError::out_of_range(
                 "step",
@@ -131,7 +131,7 @@ impl CurveRequest {
     /// [`SimError::OutOfRange`] for a tolerance outside (0, 1e-3) or traces samples outside
     /// 2..=10000; [`SimError::Budget`] for traces beyond [`super::limits::MAX_TRACE_BYTES`];
     /// [`SimError::Params`] for parameters invalid at an end of the grid.
-    pub fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
+    pub(crate) fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
         let tol = self.tolerance;
         super::limits::tolerance("tolerance", tol)?;
         for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
@@ -175,7 +175,7 @@ impl CurveRequest {
 
 /// The approach spec of a front end's request, z_c in units of `length` (m per g₀, or 1):
 /// [`default_range`] for missing ends, [`approach_spec`], with `average` the time average of
-/// every point ([`AverageOptions::for_model`]), then [`CurveRequest::configure`].
+/// every point ([`AverageOptions::for_model`]), then `CurveRequest::configure`.
 ///
 /// # Errors
 /// As those three.
@@ -211,7 +211,7 @@ pub fn approach_request(
 /// The check of a bimodal (multifrequency) approach curve (`afmdyn bimodal`, Python's
 /// `bimodal`): the drive must have at least two components
 /// ([`Params::drive_components`]); the curve is then the approach curve of that model, its
-/// document with the per-component columns ([`crate::report::component_columns`]).
+/// document with the per-component columns (`crate::report::component_columns`).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming the probe's `[drive]` arrays for a single-frequency drive.
@@ -261,7 +261,7 @@ pub(crate) fn check_single_frequency(base: &Params, what: &'static str) -> Resul
 
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
 /// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
-/// [`CurveRequest::configure`].
+/// `CurveRequest::configure`.
 ///
 /// # Errors
 /// As those three.
@@ -309,11 +309,11 @@ pub fn resonance_request(
 
 /// The default number of points of a resonance curve over [`from`, `to`] (Ω) near mode
 /// `mode` with a probe: a step no coarser than a tenth of the linewidth ω_k/Q_k
-/// ([`mode_resonance`]; 60 Hz for f₀ = 300 kHz, Q = 500), at least [`DEFAULT_CURVE_POINTS`],
+/// (`mode_resonance`; 60 Hz for f₀ = 300 kHz, Q = 500), at least [`DEFAULT_CURVE_POINTS`],
 /// at most [`crate::analysis::stepped::MAX_CURVE_POINTS`].
 ///
 /// # Errors
-/// As [`mode_resonance`].
+/// As `mode_resonance`.
 pub fn linewidth_points(base: &Params, mode: usize, from: f64, to: f64) -> Result<usize, SimError> {
     let (omega, q) = mode_resonance(base, mode)?;
     let step = omega / (10.0 * q);
@@ -333,7 +333,7 @@ pub fn linewidth_points(base: &Params, mode: usize, from: f64, to: f64) -> Resul
 ///
 /// # Errors
 /// As [`mode_resonance`] and [`free_response`].
-pub fn free_resonance_base(
+pub(crate) fn free_resonance_base(
     base: Params,
     probe: Option<&crate::probe::Probe>,
     mode: usize,

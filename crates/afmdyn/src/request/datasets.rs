@@ -130,7 +130,7 @@ impl Datasets for LyapunovRequest {
 }
 
 impl Datasets for ObserveRequest {
-    /// The observables' layout from the document ([`super::curve_layout::observe_layout`])
+    /// The observables' layout from the document (`super::curve_layout::observe_layout`)
     /// and the period.
     fn datasets(&self, model: &Resolved, o: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, o)?;
@@ -287,7 +287,7 @@ impl Datasets for AttractorsRequest {
 }
 
 impl Datasets for ContinuationRequest {
-    /// The branch points' layout ([`report::continuation_layout`]) and the parameter's name.
+    /// The branch points' layout (`report::continuation_layout`) and the parameter's name.
     fn datasets(&self, model: &Resolved, branches: &Self::Output) -> Arrays {
         let p0 = model.params.with(self.param, self.from);
         let m = CantileverModel::new(&p0)?;
@@ -318,7 +318,7 @@ impl Datasets for GlobalContinuationRequest {
 }
 
 impl Datasets for ApproachRequest {
-    /// The curve's layout from its document ([`super::curve_layout::curve_layout`]).
+    /// The curve's layout from its document (`super::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, curve)?;
         one("curve", super::curve_layout::curve_layout(&doc))
@@ -326,7 +326,7 @@ impl Datasets for ApproachRequest {
 }
 
 impl Datasets for ResonanceRequest {
-    /// The curve's layout from its document ([`super::curve_layout::curve_layout`]).
+    /// The curve's layout from its document (`super::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, curve)?;
         one("curve", super::curve_layout::curve_layout(&doc))
@@ -334,14 +334,14 @@ impl Datasets for ResonanceRequest {
 }
 
 impl Datasets for FmRequest {
-    /// The curve's layout `fm` ([`super::fm::layout`]).
+    /// The curve's layout `fm` (`super::fm::layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         one("fm", super::fm::layout(model, curve))
     }
 }
 
 impl Datasets for ReconstructRequest {
-    /// The reconstruction's layout `reconstruct` ([`super::reconstruct::layout`], with the
+    /// The reconstruction's layout `reconstruct` (`super::reconstruct::layout`, with the
     /// request's `law_force`).
     fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
         let layout = super::reconstruct::layout(r, self.law_in_order());

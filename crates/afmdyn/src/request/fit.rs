@@ -6,7 +6,7 @@
 //! needed (the lever's spring constant, the start values and the held parameters).
 
 use super::fit_result::probe_value;
-pub use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
+pub(crate) use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
@@ -136,7 +136,7 @@ fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> Si
 /// [`SimError::OutOfRange`] naming `data` and the file: refused by the reader, unreadable, a
 /// missing column or a field that is not a number.
 #[cfg(feature = "files")]
-pub fn read_force_curve(path: &std::path::Path) -> Result<Columns, SimError> {
+pub(crate) fn read_force_curve(path: &std::path::Path) -> Result<Columns, SimError> {
     use crate::io::curve_file::{read_curve_file, CurveFile};
     let file = |m: String| bad("data", path.display(), m);
     match read_curve_file(path).map_err(|e| file(e.to_string()))? {
@@ -157,7 +157,7 @@ impl FitRequest {
     /// The data's columns: the file's or the request's.
     ///
     /// # Errors
-    /// As [`read_force_curve`]; [`SimError::OutOfRange`] naming `data` where both or neither
+    /// As `read_force_curve`; [`SimError::OutOfRange`] naming `data` where both or neither
     /// are given, or a file without the `files` feature.
     pub fn columns(&self) -> Result<Columns, SimError> {
         match (&self.data, self.height.is_empty() && self.force.is_empty()) {
@@ -216,7 +216,7 @@ impl FitRequest {
     }
 
     /// The parameters fitted: `fit`, or the `sls` law's default when `fit` is the request's.
-    pub fn fitted(&self, law: LawKind) -> Vec<String> {
+    pub(crate) fn fitted(&self, law: LawKind) -> Vec<String> {
         if law == LawKind::Sls && self.fit == FitRequest::default().fit {
             return sls_curve::DEFAULT_FIT
                 .iter()
@@ -643,7 +643,7 @@ impl Analysis for FitRequest {
 /// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
 /// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
 /// `method`, `warnings`; SI throughout.
-pub fn document(request: &FitRequest, r: &FitResult) -> Value {
+pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
     let end = |e: ProfileEnd| match e {
         ProfileEnd::Crossing(_) => "crossing",
         ProfileEnd::Bound(_) => "bound",

@@ -15,7 +15,7 @@
 //! curve beside the data with its residuals, warnings).
 
 use super::fit_result::{bounds, probe_value, FitResult, MIN_FIT_ROWS};
-pub use super::fit_result::{AmData, DynamicFit, CURVE_VARIABLES};
+pub(crate) use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
@@ -33,7 +33,8 @@ fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> Si
 }
 
 /// The AM and FM columns of a CSV file's `names` and `cols`, `None` without a `z` column.
-pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
+#[cfg(feature = "files")]
+pub(crate) fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
     let col = |n: &str| names.iter().position(|c| c == n).map(|i| cols[i].clone());
     Some(AmData {
         z: col("z")?,
@@ -168,7 +169,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
     Ok(())
 }
 
-/// Run the dynamic fit of the parameters `fit` (the default when `default_fit`, [`fitted_names`]:
+/// Run the dynamic fit of the parameters `fit` (the default when `default_fit`, `fitted_names`:
 /// E, with H on DMT and W on JKR; z_offset always) on `data` under `model`'s probe, with the
 /// profile-likelihood intervals when `profiles` (the secant walk,
 /// [`ProfileWalk::Secant`] with [`MAX_SECANT_STEPS`] refits a side; else the Wald intervals).
@@ -178,7 +179,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz, DMT or JKR
 /// sample; [`SimError::Cancelled`].
-pub fn execute(
+pub(crate) fn execute(
     fit: &[String],
     default_fit: bool,
     profiles: bool,
@@ -525,7 +526,7 @@ fn lever_refusal(p: AmParam, probe: &crate::probe::Probe, data: &AmData) -> Opti
 /// The names of the parameters fitted: `fit`, or the default (when `default_fit`) E, with H on
 /// DMT (`law_name` "dmt") and the work of adhesion W (`sample.adhesion_energy`) on JKR
 /// (`law_name` "jkr"); z_offset always, last unless named.
-pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<String> {
+pub(crate) fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<String> {
     let mut names: Vec<String> = if default_fit {
         let mut v = vec!["sample.youngs_modulus".to_string()];
         if law_name == "dmt" {
@@ -546,10 +547,10 @@ pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<St
 
 /// The declared cost of a dynamic fit of `rows` rows fitting `fitted` parameters on
 /// `params` (the probe's model), with profiles when `profiles`: the worst case of its
-/// evaluations, each one stepped approach of the rows ([`super::costs::stepped_cost`], one
+/// evaluations, each one stepped approach of the rows (`super::costs::stepped_cost`, one
 /// way), z_offset's start grid, the minimiser's most evaluations
 /// ([`crate::analysis::fit::least_squares::max_evaluations`]) and, with profiles (up to
-/// [`crate::analysis::fit::estimates::MAX_PROFILED`] parameters), 2 × [`MAX_SECANT_STEPS`]
+/// `crate::analysis::fit::estimates::MAX_PROFILED` parameters), 2 × [`MAX_SECANT_STEPS`]
 /// refits per parameter of the other parameters, each at most
 /// [`crate::analysis::fit::profile::REFIT_PATIENCE`]'s evaluations. (The sensitivities of a Jacobian add one
 /// period of 2N + 4 columns per row, small beside a row's steady-state cap.)
@@ -557,7 +558,7 @@ pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<St
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built; [`SimError::Budget`] beyond the request
 /// budget, advising fewer rows or parameters, or no profiles.
-pub fn cost(
+pub(crate) fn cost(
     rows: usize,
     fitted: usize,
     profiles: bool,
@@ -599,7 +600,12 @@ pub fn cost(
 /// `amplitude_residual`, `phase`, …, or `frequency_shift`, `frequency_shift_fit`,
 /// `frequency_shift_residual` (Hz)), `preprocessing` (none; the lever's `spring_constant`),
 /// `kind` = `"am"` or `"fm"`, `law`, `units`, `method`, `warnings`.
-pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Value) -> Value {
+pub(crate) fn document(
+    r: &FitResult,
+    d: &DynamicFit,
+    estimates: Value,
+    correlation: Value,
+) -> Value {
     let o = &r.outcome;
     let m = d.data.z.len();
     let mut curve = serde_json::Map::new();

@@ -10,7 +10,7 @@ use crate::probe::ranges::si_range;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
-pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
+pub(crate) const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
     ("z", "m", "piezo position"),
     ("amplitude", "m", "amplitude, measured"),
     ("amplitude_fit", "m", "amplitude, fitted"),
@@ -43,7 +43,7 @@ pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
 
 /// How a fit's intervals were found, for its document's `method`: the profile likelihood's
 /// where any parameter was profiled, else the Wald intervals.
-pub fn intervals_method(o: &FitOutcome) -> &'static str {
+pub(crate) fn intervals_method(o: &FitOutcome) -> &'static str {
     if o.estimates.iter().any(|e| e.profile.is_some()) {
         "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, the probe keys first, Wald ±1.96 SE beyond)"
     } else {
@@ -52,12 +52,12 @@ pub fn intervals_method(o: &FitOutcome) -> &'static str {
 }
 
 /// The fewest rows fitted (more than the parameters, for the χ²'s degrees of freedom).
-pub const MIN_FIT_ROWS: usize = 8;
+pub(crate) const MIN_FIT_ROWS: usize = 8;
 
 /// The physical range [lo, hi] of a fitted quantity from the probe's ranges
-/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
+/// (`crate::probe::ranges::SI_RANGES`; a positive quantity without a lower bound there is
 /// bounded by 0); (−∞, ∞) for the contact point and the baseline.
-pub fn bounds(name: &str) -> (f64, f64) {
+pub(crate) fn bounds(name: &str) -> (f64, f64) {
     let (section, key) = match name.split_once('.') {
         Some(sk) => sk,
         None => return (f64::NEG_INFINITY, f64::INFINITY),

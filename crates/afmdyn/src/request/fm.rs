@@ -90,7 +90,7 @@ pub const FM_DEFAULT_DECAY: f64 = super::reconstruct::DECAYED / 2.0;
 /// `to` (by bisection to round-off), from Giessibl's first-order shift, which is
 /// proportional to the cosine-weighted mean force over a cycle,
 /// Δf ∝ −⟨F(z_c + A cos θ) cos θ⟩_θ (Giessibl, *Phys. Rev. B* 56, 16010 (1997), eq. 11;
-/// [`crate::analysis::fm::law_force`] the law's conservative force at distance d, the mean by
+/// `crate::analysis::fm::law_force` the law's conservative force at distance d, the mean by
 /// the midpoint rule over enough phases to resolve the closest approach, 40 across its
 /// width √(2 d_min/A)). `None` when the law has no force before contact (the
 /// shift at `to` is 0) or it does not decay within 10⁶ g₀.
@@ -141,7 +141,7 @@ pub fn default_from(base: &crate::Params, a: f64, to: f64) -> Option<f64> {
 
 impl FmRequest {
     /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
-    pub fn units(model: &Resolved) -> CurveUnits {
+    pub(crate) fn units(model: &Resolved) -> CurveUnits {
         match &model.probe {
             Some(p) => CurveUnits::from_scales(&p.scales, true),
             None => CurveUnits::dimensionless(),
@@ -357,7 +357,7 @@ const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
 /// lever's operating point), the cantilever's constants that [`super::reconstruct`] needs
 /// (`spring_constant`, `resonance_frequency`, `amplitude`), `units` (those of the columns it
 /// lists, and with a probe the spring constant's), `method`, `warnings`.
-pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
+pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
     let frame = Frame::new(model, curve);
     let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
@@ -429,7 +429,7 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
 /// `COLUMNS`, in the document's units (SI with a probe, the model's without; `deg` for the
 /// phase, `1` for the pure numbers); `stable` flags, `iterations` integers. What Python's
 /// `afmdyn.fm` returns.
-pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
+pub(crate) fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
     let frame = Frame::new(model, curve);
     let p = &curve.points;
     let variables = columns::variables(
@@ -444,7 +444,7 @@ pub fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
 
 /// The table of an FM curve (`fm.csv`): the names of `COLUMNS` and one row per z_c reached
 /// (`stable` as 1/0).
-pub fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
+pub(crate) fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
     let frame = Frame::new(model, curve);
     let rows = columns::rows(&COLUMNS, &frame, &curve.points);
     (columns::names(&COLUMNS), rows)

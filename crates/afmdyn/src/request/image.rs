@@ -52,10 +52,10 @@ mod sample;
 mod study;
 pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy, MAX_STUDY_RATIOS};
 
-pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
+pub(crate) use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
 /// Largest number of domains of a sample map.
-pub const MAX_DOMAINS: usize = 1000;
+pub(crate) const MAX_DOMAINS: usize = 1000;
 
 /// One domain of a [`SampleMap`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -297,7 +297,7 @@ impl ImageRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `pixels`, `lines` (1..=4096; 1 for a line map) or
-    /// `curve_points` (8..=2000); [`SimError::Budget`] for an image over [`MAX_IMAGE_BYTES`].
+    /// `curve_points` (8..=2000); [`SimError::Budget`] for an image over `MAX_IMAGE_BYTES`.
     pub fn validate_grid(&self, map: &SampleMap) -> Result<(), SimError> {
         if !(1..=MAX_PIXELS).contains(&self.pixels) {
             return Err(SimError::out_of_range(
@@ -355,7 +355,7 @@ pub(crate) const IMAGE_BYTES_PER_PIXEL: f64 = 1000.0;
 /// The largest memory an image may take, estimated before the run: 1.1 GiB, about the traces'
 /// budget of a curve ([`super::limits::MAX_TRACE_BYTES`]), so that 1024 × 1024 pixels fit and
 /// 2048 × 2048 (which aborted on allocation) is refused naming the budget.
-pub const MAX_IMAGE_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_IMAGE_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
 
 /// One material's approach curve: the background or a domain's sample under the probe's lever
 /// and drive.

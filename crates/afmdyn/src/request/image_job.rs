@@ -2,14 +2,14 @@
 //! feedback (ideal, or a PI scan with its settings) and the setpoint study; its run as an
 //! [`super::run::Analysis`] (cost, execution, document and presentation) is the study layer's
 //! (`crate::study::image`), and so is its PI scan's run resumably into a store
-//! (`crate::study::stored::Resumable`, its study [`ImageJob::scan_study`]).
+//! (`crate::study::stored::Resumable`, its study `ImageJob::scan_study`).
 
 use super::image::{background_probe, Image, ImageRequest, SampleMap, SetpointStudy};
 use super::image_options::GivenOptions;
 use super::image_peakforce::PeakForceImage;
+use super::image_scan::{PiImage, PiScan};
 #[cfg(feature = "files")]
-use super::image_scan::ScanRecipe;
-use super::image_scan::{PiImage, PiScan, ScanStudy};
+use super::image_scan::{ScanRecipe, ScanStudy};
 use super::named::Outcome;
 use super::run::Resolved;
 use crate::error::SimError;
@@ -70,7 +70,8 @@ impl ImageJob {
     ///
     /// # Errors
     /// As [`ScanStudy::new`].
-    pub fn scan_study(&self) -> Result<Option<ScanStudy>, SimError> {
+    #[cfg(feature = "files")]
+    pub(crate) fn scan_study(&self) -> Result<Option<ScanStudy>, SimError> {
         self.feedback
             .as_ref()
             .map(|scan| ScanStudy::new(&self.probe, &self.sample, &self.request, scan))
@@ -84,7 +85,7 @@ impl ImageJob {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImageKeywords {
-    /// The sample map: its TOML text or path ([`SampleMap::read`]).
+    /// The sample map: its TOML text or path (`SampleMap::read`).
     pub sample: String,
     /// Setpoint: the ratio A_sp/A₀ in (0, 1) (AM), the peak force in N (PeakForce).
     pub setpoint: f64,
@@ -177,7 +178,7 @@ impl ImageKeywords {
 
 impl ImageOutput {
     /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
-    /// `image.nc`'s variables, [`super::image_layout`]) and, as the fact `summary`, the
+    /// `image.nc`'s variables, `super::image_layout`) and, as the fact `summary`, the
     /// command line's `image.json` ([`super::present::image`]).
     pub fn outcome(&self, setpoint: f64) -> Outcome {
         use super::image_layout::{layout, peakforce_layout, scan_layout};

@@ -15,7 +15,7 @@ const SI: UnitNames = UnitNames::si_or_model(true);
 
 /// The codes of `regime`: 0 where the setpoint is not reached, 1 attractive, 2 repulsive (CF
 /// `flag_values` and `flag_meanings`).
-pub const REGIME_FLAGS: [(i32, &str); 3] =
+pub(crate) const REGIME_FLAGS: [(i32, &str); 3] =
     [(0, "not_reached"), (1, "attractive"), (2, "repulsive")];
 
 /// A name as one word of a CF `flag_meanings` list (blanks become `_`).
@@ -84,7 +84,7 @@ fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
 /// background) and `domain` (0 the background, k the map's k-th domain), each 32-bit integer
 /// codes with their CF `flag_values` and `flag_meanings`; the scalars `setpoint` (A_sp/A₀, as
 /// given) and `reference_z_c` (m).
-pub fn layout(img: &Image, setpoint: f64) -> Layout {
+pub(crate) fn layout(img: &Image, setpoint: f64) -> Layout {
     let (nx, ny) = (img.x.len(), img.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
     let mut variables = vec![
@@ -133,7 +133,7 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
 /// [`layout`]), `ideal_height` (m, the ideal image's apparent height), `true_height` (m) and
 /// `domain`; the scalars `setpoint`, `reference_z_c` (m), `scan_rate` (Hz),
 /// `proportional_gain` (1), `integral_gain` (1/s) and `time_constant` (s).
-pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
+pub(crate) fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
     let g = &img.ideal;
     let (nx, ny) = (g.x.len(), g.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
@@ -305,7 +305,7 @@ pub(crate) fn peakforce_layout(img: &PeakForceImage) -> Layout {
 
 /// A number map's summary in an image's JSON document: `units`, the `min`, `max` and `mean`
 /// of the finite ones of `values` (null where there is none) and `finite` (their number).
-pub fn number_summary(units: &str, values: impl Iterator<Item = f64>) -> serde_json::Value {
+pub(crate) fn number_summary(units: &str, values: impl Iterator<Item = f64>) -> serde_json::Value {
     use serde_json::{json, Value};
     let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
     let finite: Vec<f64> = values.filter(|x| x.is_finite()).collect();
@@ -322,7 +322,7 @@ pub fn number_summary(units: &str, values: impl Iterator<Item = f64>) -> serde_j
 /// (y, x): a float map's `units`, `min`, `max` and `mean` over its finite values (null where it
 /// has none) and `finite` (their number); a flag or code map's count of pixels per meaning
 /// (`counts`).
-pub fn summary(layout: &Layout) -> serde_json::Value {
+pub(crate) fn summary(layout: &Layout) -> serde_json::Value {
     use serde_json::{json, Map, Value};
     let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
     let ends = |name: &str| -> Value {

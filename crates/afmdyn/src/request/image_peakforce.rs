@@ -21,7 +21,7 @@
 //!   orbit's own fixed point, is at the setpoint to the feedback's tolerance: a change of
 //!   material costs one tap. Were it off, the secant's first step is from the lever's static
 //!   compliance c (the quasi-static slope |dF_peak/dα5| ≤ 1/c: the first step falls short of
-//!   the root, never across a fold), at most [`CONTINUE_ITERATIONS`] taps. (Continuing from
+//!   the root, never across a fold), at most `CONTINUE_ITERATIONS` taps. (Continuing from
 //!   the previous material's orbit and z_c instead cost 6.4 taps per change, issue 61.)
 //! - where the continuation does not converge (a tap that does not settle, a fold of the
 //!   steady taps) the pixel is re-engaged from far on its material (counted and reported);
@@ -54,7 +54,7 @@ use serde_json::Value;
 
 /// Most taps of the secant continuation at a change of material before the pixel is
 /// re-engaged from far.
-pub const CONTINUE_ITERATIONS: usize = 30;
+pub(crate) const CONTINUE_ITERATIONS: usize = 30;
 
 /// Taps a change of material is expected to cost (the request's cost estimate): one, from the
 /// material's engaged orbit (module docs).
@@ -143,7 +143,7 @@ pub struct PeakForceImageStudy {
 /// As the background probe of an AM image (a probe the format refuses, a multifrequency
 /// drive); [`SimError::OutOfRange`] naming `excitation` for a probe without
 /// an off-resonance drive, `setpoint` for a setpoint that is not a finite force > 0.
-pub fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe, SimError> {
+pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe, SimError> {
     let background = background_probe(probe_table)?;
     if !background.off_resonance {
         return Err(SimError::out_of_range(
@@ -210,7 +210,7 @@ impl PeakForceImageStudy {
     /// the materials' models and their engages from far (module docs).
     ///
     /// # Errors
-    /// As [`PeakForceImageStudy::unengaged`]; [`SimError::Cancelled`].
+    /// As `PeakForceImageStudy::unengaged`; [`SimError::Cancelled`].
     pub fn new(
         probe_table: &toml::Table,
         map: &SampleMap,
@@ -230,7 +230,7 @@ impl PeakForceImageStudy {
     /// # Errors
     /// As [`ImageRequest::validate_grid`] and [`peakforce_probe`]; [`SimError::Probe`] for a
     /// domain's sample the probe format refuses.
-    pub fn unengaged(
+    pub(crate) fn unengaged(
         probe_table: &toml::Table,
         map: &SampleMap,
         req: &ImageRequest,
@@ -283,7 +283,7 @@ impl PeakForceImageStudy {
     /// # Errors
     /// [`SimError::Cancelled`]; a setpoint the material does not reach is the engage's
     /// message, not an error.
-    pub fn engage(&self, m: usize) -> Result<Engage, SimError> {
+    pub(crate) fn engage(&self, m: usize) -> Result<Engage, SimError> {
         let params = self.materials[m].params;
         let opts = SetpointOptions {
             tap: self.options.clone(),
@@ -309,7 +309,7 @@ impl PeakForceImageStudy {
     }
 
     /// The study with the materials' engages (in the order of the materials).
-    pub fn with_engages(mut self, engages: Vec<Engage>) -> PeakForceImageStudy {
+    pub(crate) fn with_engages(mut self, engages: Vec<Engage>) -> PeakForceImageStudy {
         for (m, (evaluations, e)) in self.materials.iter_mut().zip(engages) {
             m.evaluations = evaluations;
             m.engaged = e.map(|(a5, z, tap)| (a5, DVector::from_vec(z), tap));
@@ -699,7 +699,7 @@ impl PeakForceImage {
     /// The document's keys other than `image` ([`PeakForceImage::document`]): `mode`,
     /// `feedback`, `setpoint` (N), `reference_z_c` (m), `materials` (name, true modulus, the
     /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
-    pub fn document_head(&self) -> Value {
+    pub(crate) fn document_head(&self) -> Value {
         use serde_json::json;
         let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
         json!({
@@ -720,7 +720,7 @@ impl PeakForceImage {
     }
 
     /// Steady taps computed for the image: the materials' engages and the lines' continuations.
-    pub fn taps(&self) -> usize {
+    pub(crate) fn taps(&self) -> usize {
         self.materials.iter().map(|m| m.evaluations).sum::<usize>()
             + self
                 .pixels

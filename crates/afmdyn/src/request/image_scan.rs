@@ -7,7 +7,7 @@
 //! **An image is a study** ([`ScanStudy`], [`crate::study::Study`]): its tasks are its lines,
 //! each engaged from far on its first pixel's material (the steady state of the approach curve's
 //! farthest point; the controller brings the tip down to the setpoint for
-//! [`ENGAGE_LOOP_TIMES`] loop time constants 1/K_I), then scanned from x = 0 to Lx (trace) and
+//! `ENGAGE_LOOP_TIMES` loop time constants 1/K_I), then scanned from x = 0 to Lx (trace) and
 //! back (retrace) at the scan rate. Every line depends only on the request and its number, so
 //! the image does not depend on the thread count or on the executor (the rayon pool, Dask).
 //!
@@ -49,10 +49,10 @@ use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
 
 /// Most drive periods a scan may integrate (lines × (engage + 2 × pixels × periods per pixel)).
-pub const MAX_SCAN_PERIODS: u64 = 1_000_000_000;
+pub(crate) const MAX_SCAN_PERIODS: u64 = 1_000_000_000;
 
 /// Loop time constants 1/K_I of a line's engage.
-pub const ENGAGE_LOOP_TIMES: f64 = 20.0;
+pub(crate) const ENGAGE_LOOP_TIMES: f64 = 20.0;
 
 /// Loop time constants 1/K_I a pixel lasts at the default scan rate.
 pub const PIXEL_LOOP_TIMES: f64 = 5.0;
@@ -172,7 +172,7 @@ pub struct ScanStudy {
 /// as [`LineSpec`]; `length` is g₀ in m). Its lines are those of the study it came from, bit
 /// for bit, wherever it is sent (serde: every number as its bits).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LineJob {
+pub(crate) struct LineJob {
     spec: LineSpec,
     /// Per material: where a line starting on it engages.
     engage: Vec<Engage>,
@@ -350,7 +350,7 @@ impl ScanStudy {
     /// the drive frequency over 2 × pixels: a pixel needs a drive period; and at most
     /// [`MAX_SCAN_PERIODS`] periods in all), `gains` (K_P ≥ 0, K_I > 0, finite) or
     /// `time_constant` (≥ 0, finite, at most 1 000 s).
-    pub fn new(
+    pub(crate) fn new(
         probe_table: &toml::Table,
         map: &SampleMap,
         req: &ImageRequest,
@@ -440,7 +440,8 @@ impl ScanStudy {
     ///
     /// # Errors
     /// As [`ScanStudy::new`].
-    pub fn from_recipe(r: &ScanRecipe) -> Result<ScanStudy, SimError> {
+    #[cfg(feature = "files")]
+    pub(crate) fn from_recipe(r: &ScanRecipe) -> Result<ScanStudy, SimError> {
         ScanStudy::new(&r.probe, &r.map, &r.request, &r.scan)
     }
 
@@ -454,15 +455,10 @@ impl ScanStudy {
         self.ideal.y.len()
     }
 
-    /// The settings.
-    pub fn settings(&self) -> &ScanSettings {
-        &self.settings
-    }
-
-    /// Scan line `t` (trace and retrace): [`LineJob::line`] of [`ScanStudy::line_job`].
+    /// Scan line `t` (trace and retrace): `LineJob::line` of `ScanStudy::line_job`.
     ///
     /// # Errors
-    /// As [`LineJob::line`].
+    /// As `LineJob::line`.
     pub fn line(&self, t: usize, cancel: &AtomicBool) -> Result<ScanLine, SimError> {
         self.job.line(t, cancel)
     }
@@ -470,7 +466,8 @@ impl ScanStudy {
     /// What scanning a line needs, without the materials' approach curves that
     /// [`ScanStudy::new`] computes: a distributed scan sends it to its workers once (the
     /// stage's start, [`crate::study::plan`]), so that a worker does not build the study.
-    pub fn line_job(&self) -> &LineJob {
+    #[cfg(feature = "files")]
+    pub(crate) fn line_job(&self) -> &LineJob {
         &self.job
     }
 

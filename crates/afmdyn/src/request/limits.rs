@@ -8,17 +8,17 @@
 pub const MAX_RUN_PERIODS: f64 = 1e8;
 /// Largest time series streamed to files (`afmdyn simulate` writes timeseries.npy, and
 /// timeseries.csv on request), in bytes.
-pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 /// Largest time series held in memory (a Python call returns its arrays whole), in bytes: a
 /// quarter of this machine class's 24 GiB less room for the caller.
-pub const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
 /// Largest memory the traces of a stepped curve (`approach`/`resonance --traces`) may take, in
 /// bytes, estimated before the run for the worst case (every trace over
 /// [`crate::analysis::traces::MAX_TRACE_PERIODS`] drive periods): 1 GiB, so that the traces and
 /// the copies a front end makes of them (files, NumPy arrays) stay within a few GiB.
-pub const MAX_TRACE_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_TRACE_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 /// Bytes of one trace sample: deflection, distance and force, 8 bytes each.
-pub const TRACE_BYTES_PER_SAMPLE: f64 = 24.0;
+pub(crate) const TRACE_BYTES_PER_SAMPLE: f64 = 24.0;
 pub use crate::io::input::{MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};
 /// The range of every integrator tolerance (relative and absolute; the adaptive, split and
 /// Taylor integrators use it, the exact propagator and RK4 ignore it but it is checked alike): below 1e-16 it is beneath the double's resolution, above 1e-3 no longer an accuracy.
@@ -30,7 +30,7 @@ pub use crate::analysis::steady::MAX_STEADY_PERIODS;
 /// Samples per drive period at which attractors are recorded (their plots and files); the
 /// integrator of the census is built for this rate, so the same request gives the same
 /// attractors in every front end.
-pub const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
+pub(crate) const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
 /// Largest number of worker threads a sweep may ask for.
 pub const MAX_THREADS: usize = 1024;
 // the bound as `check_threads`'s message spells it
@@ -41,7 +41,7 @@ const _: () = assert!(MAX_THREADS == 1024);
 ///
 /// # Errors
 /// [`crate::SimError::OutOfRange`] naming `threads`.
-pub fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
+pub(crate) fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
     match threads {
         Some(t) if !(1..=MAX_THREADS).contains(&t) => Err(crate::SimError::out_of_range(
             "threads",
@@ -52,7 +52,7 @@ pub fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
     }
 }
 /// What a request costs ([`crate::request::Analysis::cost`]), estimated before it runs for the
-/// worst case its options allow ([`crate::request::costs`]).
+/// worst case its options allow (`crate::request::costs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cost {
     /// Peak memory, in bytes.
@@ -63,7 +63,7 @@ pub struct Cost {
 
 /// Largest peak memory of a request, estimated before it runs, in bytes: 1.1 GiB, the budget
 /// of an image (`MAX_IMAGE_BYTES` of `crate::request::image`, where 2048 × 2048 pixels aborted
-/// on allocation) and about that of a curve's traces ([`MAX_TRACE_BYTES`]): what a request and
+/// on allocation) and about that of a curve's traces (`MAX_TRACE_BYTES`): what a request and
 /// the copies a front end makes of its result (files, NumPy arrays) hold within a few GiB.
 pub const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
 
@@ -86,23 +86,23 @@ pub const MAX_CONVERGE_SAMPLES: usize = 10_000_000;
 pub const MAX_OBSERVE_PERIODS: usize = crate::analysis::observables::MAX_PERIODS;
 /// Largest modal state entry of an initial state: states of norm
 /// [`crate::params::STATE_NORM_MAX`] count as diverged.
-pub const MAX_INITIAL_ENTRY: f64 = crate::params::STATE_NORM_MAX / 10.0;
+pub(crate) const MAX_INITIAL_ENTRY: f64 = crate::params::STATE_NORM_MAX / 10.0;
 
 // the limit is the physical range of a rest distance, declared with the probe's ranges
-pub use crate::probe::ranges::MAX_SI_DISTANCE;
+pub(crate) use crate::probe::ranges::MAX_SI_DISTANCE;
 
 /// Drive frequencies (Hz) are accepted within [1e-2, 1e4] × the probe's own drive frequency:
 /// wider than the band of any of its 20 modes, narrow enough to catch a value meant in kHz or
 /// MHz but written in Hz (1e3 or 1e6 too small).
 pub(crate) const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 
-pub use crate::analysis::tolerance;
+pub(crate) use crate::analysis::tolerance;
 
 /// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
 ///
 /// # Errors
 /// [`crate::SimError::OutOfRange`] naming `name`, with the hint that lengths are in metres.
-pub fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+pub(crate) fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
     if v.is_finite() && v.abs() > MAX_SI_DISTANCE {
         return Err(crate::SimError::out_of_range(
             name,

@@ -17,11 +17,11 @@
 //! - [`named`]: every analysis by its name ([`named::parse`]), run to an [`Outcome`]: its
 //!   document and its arrays as layouts ([`Datasets`]); the one door of Python and WebAssembly.
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason, and the budgets of
-//!   a request's cost ([`limits::Cost`]), which [`costs`] estimates before it runs.
+//!   a request's cost ([`limits::Cost`]), which `costs` estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
-//! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
-//!   (feature `files`) in a directory ([`checkpoint_file`]), locked for one run at a time
+//! - [`checkpoint`]: resumable sweeps: the `Checkpoint` a store implements, in memory or
+//!   (feature `files`) in a directory (`checkpoint_file`), locked for one run at a time
 //!   ([`crate::io::dir_lock`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
@@ -33,16 +33,16 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
-pub mod chart_layout;
+pub(crate) mod chart_layout;
 pub mod checkpoint;
 #[cfg(feature = "files")]
-pub mod checkpoint_file;
-pub mod costs;
-pub mod curve_layout;
+pub(crate) mod checkpoint_file;
+pub(crate) mod costs;
+pub(crate) mod curve_layout;
 pub mod curves;
 mod datasets;
 #[cfg(feature = "files")]
-pub use crate::io::dir_lock;
+pub(crate) use crate::io::dir_lock;
 pub mod fm;
 #[cfg(feature = "files")]
 pub use crate::io::height_map as height_map_file;
@@ -51,7 +51,7 @@ pub mod fit_dynamic;
 pub(crate) mod fit_result;
 pub mod image;
 pub mod image_job;
-pub mod image_layout;
+pub(crate) mod image_layout;
 pub mod image_options;
 pub mod image_peakforce;
 pub mod image_scan;
@@ -63,14 +63,14 @@ pub mod modes;
 pub mod named;
 pub mod peakforce;
 pub(crate) mod peakforce_sweep;
-pub mod pool;
+pub(crate) mod pool;
 pub mod present;
 pub mod reconstruct;
-pub mod reconstruct_document;
+pub(crate) mod reconstruct_document;
 pub mod run;
 pub mod simulate;
 #[cfg(feature = "files")]
-pub mod simulate_files;
+pub(crate) mod simulate_files;
 #[cfg(feature = "files")]
 pub mod simulate_stream;
 pub mod sweep;
@@ -82,9 +82,10 @@ pub use analyses::{
 };
 pub use basins::{BasinArrays, BasinsRequest};
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
-pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 #[cfg(feature = "files")]
-pub use checkpoint_file::FileCheckpoint;
+pub(crate) use checkpoint::MemoryCheckpoint;
+#[cfg(feature = "files")]
+pub(crate) use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};
@@ -94,21 +95,17 @@ pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};
 pub use named::{Datasets, Named, Outcome};
 pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
-pub use pool::in_pool;
-#[cfg(feature = "parallel")]
-pub use pool::thread_pool;
+pub(crate) use pool::in_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
     admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document, Resolved,
     ResonanceRequest,
 };
-pub use sweep::{fingerprint, SweepRecord};
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a
 // run counts in, the results the curve and reconstruction requests return, the integrators a
 // request names, and the contact laws' registry with the force's sign convention
 pub use crate::analysis::progress::Progress;
-pub use crate::analysis::reconstruct::Reconstruction;
 pub use crate::analysis::stepped::SteppedCurve;
 pub use crate::contact::{LawGroups, LawKind, FORCE_SIGN, GROUPS, LAWS};
 pub use crate::integrate::IntegratorKind;

@@ -184,7 +184,7 @@ const AFTER_GROUPS: [ParamInfo; 2] = [
 
 /// Every model parameter a request takes, in the order the front ends list them: the model's
 /// own, the law groups of the registry ([`crate::contact::GROUPS`], each described by its
-/// law's [`crate::contact::Param`]), then `z_c` and `drive_frequency`, SI values that need a
+/// law's `crate::contact::Param`), then `z_c` and `drive_frequency`, SI values that need a
 /// probe file. The ranges are those [`Params::validate`] and [`ContactLaw::validate`] enforce.
 pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::LazyLock::new(|| {
     let groups = GROUPS.iter().map(|g| ParamInfo {
@@ -458,7 +458,7 @@ impl ModelSpec {
     /// # Errors
     /// [`SimError::NotFinite`] naming the first value that is not finite by its request name
     /// (`contact_stiffness`, `z_c`, …).
-    pub fn check_finite(&self) -> Result<(), SimError> {
+    pub(crate) fn check_finite(&self) -> Result<(), SimError> {
         for (name, v) in self.reals() {
             if let Some(x) = v {
                 crate::error::finite(name, x)?;
@@ -623,7 +623,7 @@ fn omega_of_drive_frequency(f: f64, probe: Option<&Probe>) -> Result<f64, SimErr
 /// The model values a probe file sets in SI, refused as dimensionless values when a probe is
 /// given (its scales would not apply to them: `hamaker = 6.6e-20` taken as H̃ is not the
 /// Hamaker constant in J): the value's name and what to give instead. The law's groups say
-/// it themselves ([`crate::contact::Param::under_probe`], [`probe_sets`]). `modes`,
+/// it themselves (`crate::contact::Param::under_probe`, `probe_sets`). `modes`,
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
 pub const PROBE_SETS: [(&str, &str); 9] = [
@@ -676,7 +676,7 @@ pub const PROBE_SETS: [(&str, &str); 9] = [
 
 /// What to give instead of `name` under a probe ([`PROBE_SETS`], or the law group's
 /// [`crate::contact::Param::under_probe`]), if a probe sets it.
-pub fn probe_sets(name: &str) -> Option<std::borrow::Cow<'static, str>> {
+pub(crate) fn probe_sets(name: &str) -> Option<std::borrow::Cow<'static, str>> {
     if let Some((_, allowed)) = PROBE_SETS.iter().find(|(key, _)| *key == name) {
         return Some((*allowed).into());
     }

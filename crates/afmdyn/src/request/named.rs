@@ -8,10 +8,12 @@
 //!
 //! The names are those of [`NAMES`]; `simulate` records its trajectory whole in memory
 //! (its own budgets, [`SimulateRequest::validate_in_memory`]) and `bimodal` is the approach
-//! curve of a multifrequency drive ([`super::curves::check_bimodal`]).
+//! curve of a multifrequency drive (`super::curves::check_bimodal`).
 
 use super::reconstruct_document::FromDocument;
-use super::run::{document, run, Analysis, Resolved};
+#[cfg(feature = "files")]
+use super::run::document;
+use super::run::{run, Analysis, Resolved};
 use super::{
     ApproachRequest, AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
     FmRequest, GlobalContinuationRequest, LyapunovRequest, ModesRequest, ObserveRequest,
@@ -255,7 +257,8 @@ pub fn default_request(name: &str) -> Option<Value> {
 ///
 /// # Errors
 /// As [`document`] and [`Datasets::datasets`].
-pub fn outcome<A: Datasets>(
+#[cfg(feature = "files")]
+pub(crate) fn outcome<A: Datasets>(
     request: &A,
     model: &Resolved,
     output: &A::Output,

@@ -101,7 +101,7 @@ pub struct PeakForceResult {
 
 impl PeakForceRequest {
     /// The units of the document: SI with a probe, else the model's.
-    pub fn units(model: &Resolved) -> CurveUnits {
+    pub(crate) fn units(model: &Resolved) -> CurveUnits {
         match &model.probe {
             Some(p) => CurveUnits::from_scales(&p.scales, true),
             None => CurveUnits::dimensionless(),
@@ -218,7 +218,7 @@ impl PeakForceRequest {
     /// [`SimError::OutOfRange`] naming `sweep` (no values, too many, a value that is not
     /// finite, out of the probe's range of distances, or a frequency not off resonance), or
     /// `setpoint` with a sweep in z_c (the feedback sets z_c).
-    pub fn sweep_points(
+    pub(crate) fn sweep_points(
         &self,
         sweep: &PeakForceSweep,
         model: &Resolved,
@@ -315,10 +315,10 @@ fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
 
 /// A DMT fit whose root-mean-square residual passes this fraction of the fitted force range
 /// is said not to be the DMT relation's shape.
-pub const MAX_FIT_RESIDUAL: f64 = 0.1;
+pub(crate) const MAX_FIT_RESIDUAL: f64 = 0.1;
 /// A modulus_dmt more than this fraction off the sample's own E* (which a simulation knows) is
 /// said to be biased.
-pub const MAX_MODULUS_BIAS: f64 = 0.1;
+pub(crate) const MAX_MODULUS_BIAS: f64 = 0.1;
 
 /// Why a single tap's `modulus_dmt` is missing, or where it is not the sample's modulus
 /// (issue 77): no fit (too few retract points in the band), a fit residual above
@@ -379,7 +379,7 @@ pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
 /// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
 /// (time, deflection, distance, force from the largest separation) and `curve` (the
 /// force–distance curve, approach and retract), `z_c`, `units`, `method`, `warnings`.
-pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
+pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
     let u = PeakForceRequest::units(model);
     let tap = &r.tap;
     let c = &tap.channels;

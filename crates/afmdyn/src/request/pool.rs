@@ -9,7 +9,7 @@ use crate::error::SimError;
 /// # Errors
 /// [`SimError::OutOfRange`] naming `threads` when the pool cannot start.
 #[cfg(feature = "parallel")]
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SimError> {
+pub(crate) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SimError> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
@@ -23,7 +23,7 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SimError
 /// # Errors
 /// As [`thread_pool`]; `f`'s errors.
 #[cfg(feature = "parallel")]
-pub fn in_pool<T: Send>(
+pub(crate) fn in_pool<T: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> Result<T, SimError> + Send,
 ) -> Result<T, SimError> {
@@ -38,7 +38,7 @@ pub fn in_pool<T: Send>(
 /// # Errors
 /// `f`'s errors.
 #[cfg(not(feature = "parallel"))]
-pub fn in_pool<T: Send>(
+pub(crate) fn in_pool<T: Send>(
     _threads: Option<usize>,
     f: impl FnOnce() -> Result<T, SimError> + Send,
 ) -> Result<T, SimError> {

@@ -7,22 +7,22 @@
 //! `cantilevers`) call theirs directly.
 
 #[cfg(feature = "files")]
-pub mod census;
+pub(crate) mod census;
 #[cfg(feature = "files")]
 pub(crate) mod continuation;
 #[cfg(feature = "files")]
-pub mod converge;
+pub(crate) mod converge;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fit;
 pub mod fm;
 pub mod image;
-pub mod maps;
-pub mod modes;
+pub(crate) mod maps;
+pub(crate) mod modes;
 pub(crate) mod orbits;
 pub mod peakforce;
 pub mod reconstruct;
-pub mod sweeps;
+pub(crate) mod sweeps;
 
 /// Which files a presentation holds (`--files`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

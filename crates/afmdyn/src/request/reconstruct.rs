@@ -6,7 +6,7 @@
 //! spring constant in N/m; the force in N, the potential in J.
 //!
 //! **Ranges.** Each constant has a physical range outside which it is refused and a typical
-//! range outside which the document warns of a likely unit slip ([`CONSTANTS`]):
+//! range outside which the document warns of a likely unit slip (`CONSTANTS`):
 //!
 //! | constant | refused outside | typical (else a warning) |
 //! |---|---|---|
@@ -92,7 +92,7 @@ pub enum FmInversion {
 
 impl FmInversion {
     /// The request's word: `"sader-jarvis"` or `"exact"`.
-    pub fn word(self) -> &'static str {
+    pub(crate) fn word(self) -> &'static str {
         match self {
             FmInversion::SaderJarvis => "sader-jarvis",
             FmInversion::Exact => "exact",
@@ -103,7 +103,7 @@ impl FmInversion {
 /// The probe quantities of the constants `amplitude`, `resonance_frequency`,
 /// `spring_constant` (in that order): their ranges are the probe's, declared once in
 /// [`crate::probe::ranges`].
-pub const CONSTANTS: [(&str, &str, &str); 3] = [
+pub(crate) const CONSTANTS: [(&str, &str, &str); 3] = [
     ("amplitude", "drive", "free_amplitude"),
     ("resonance_frequency", "cantilever", "resonance_frequency"),
     ("spring_constant", "cantilever", "spring_constant"),
@@ -123,7 +123,7 @@ impl ReconstructRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming the field: a constant outside its physical range
-    /// ([`CONSTANTS`]), neither or both of `distance` and `z_c`, and as [`ShiftCurve::validate`]
+    /// (`CONSTANTS`), neither or both of `distance` and `z_c`, and as [`ShiftCurve::validate`]
     /// (distances not monotonic among them).
     pub fn curve(&self) -> Result<ShiftCurve, SimError> {
         // the constants first: a wrong unit would otherwise show as distances out of order
@@ -184,7 +184,7 @@ impl ReconstructRequest {
     }
 
     /// The document's warnings on the request: a constant outside its typical range (a likely
-    /// unit slip, [`CONSTANTS`]); data that end before the shift has decayed (|Δf| at the largest
+    /// unit slip, `CONSTANTS`); data that end before the shift has decayed (|Δf| at the largest
     /// distance above [`DECAYED`] of its extreme).
     pub fn warnings(&self) -> Vec<String> {
         let mut warnings: Vec<String> = CONSTANTS
@@ -224,7 +224,7 @@ impl ReconstructRequest {
     }
 
     /// `law_force` in the order of [`Self::curve`] (increasing distance).
-    pub fn law_in_order(&self) -> Option<Vec<f64>> {
+    pub(crate) fn law_in_order(&self) -> Option<Vec<f64>> {
         let mut law = self.law_force.clone()?;
         let d = self.distance.as_ref().or(self.z_c.as_ref())?;
         if d.len() >= 2 && d[0] > d[1] {
@@ -235,7 +235,7 @@ impl ReconstructRequest {
 }
 
 impl ReconstructRequest {
-    /// The request of an `afmdyn fm` document in SI ([`super::fm::document`]): the distances
+    /// The request of an `afmdyn fm` document in SI (`super::fm::document`): the distances
     /// of closest approach `curve.min_distance` (the lower turning points, static deflection
     /// included), `curve.frequency_shift`, and the document's `spring_constant`,
     /// `resonance_frequency` and `amplitude` — each of the three replaced by the value given.
@@ -369,7 +369,7 @@ fn present_reconstruction(
 }
 
 /// `reconstruct --am`: the AM matrix inversion of an `afmdyn approach --probe` document of
-/// the point mass ([`am_curve_from_approach`], [`am_reconstruction`]).
+/// the point mass (`am_curve_from_approach`, `am_reconstruction`).
 #[derive(Debug, Clone)]
 pub struct AmReconstruction(pub Value);
 
@@ -418,7 +418,7 @@ impl Analysis for AmReconstruction {
 /// `sader_jarvis_residual`, `forward_residual`, `converged`).
 ///
 /// [`ExactRecord`]: crate::analysis::reconstruct::ExactRecord
-pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
+pub(crate) fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
     let mut force = json!({"distance": r.distance, "force": r.force, "potential": r.potential});
     if let Some(law) = request.law_in_order() {
         force["law"] = json!(law);
@@ -463,7 +463,7 @@ pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
 /// [`SimError::OutOfRange`] naming `am` for a document that is not such a document (no
 /// `approach` or `si`, another model: the inversion's balance is the point mass's, force-driven
 /// equation), or with fewer than 3 attractive points.
-pub fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
+pub(crate) fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
     let bad = |what: &'static str| {
         SimError::out_of_range(
             "am",
@@ -543,7 +543,7 @@ pub fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
 
 /// The document of an AM reconstruction (`afmdyn reconstruct --am`): as [`document`]'s, with
 /// `amplitude` the free amplitude A₀, `quality_factor`, `drive_frequency` and the points used.
-pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
+pub(crate) fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
     json!({
         "force": {"distance": r.distance, "force": r.force, "potential": r.potential},
         "spring_constant": curve.spring_constant,
@@ -575,7 +575,7 @@ pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
 /// # Errors
 /// As [`am_curve_from_approach`] and the inversion
 /// ([`crate::analysis::reconstruct_am::matrix_inversion`]).
-pub fn am_reconstruction(
+pub(crate) fn am_reconstruction(
     approach: &Value,
     progress: &Progress,
 ) -> Result<super::run::Document<Reconstruction>, SimError> {
@@ -607,9 +607,9 @@ const RECONSTRUCT_VARIABLES: [(&str, &str, &str); 3] = [
 /// The layout of a reconstruction `r` (what Python's `afmdyn.reconstruct` returns): over
 /// `distance` (the distance of closest approach d in m, increasing; its coordinate) `law`
 /// (N; with `law`, the model's force at each distance in that order:
-/// [`ReconstructRequest::law_in_order`]), `force` (N) and `potential` (J), SI as the
+/// `ReconstructRequest::law_in_order`), `force` (N) and `potential` (J), SI as the
 /// documents.
-pub fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
+pub(crate) fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
     use crate::layout::{Layout, Variable};
     let d = ["distance"];
     let mut variables = vec![Variable::f64(

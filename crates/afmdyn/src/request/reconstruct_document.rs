@@ -16,7 +16,7 @@ use serde_json::Value;
 /// The keywords of a reconstruction from a document ([module docs](self)).
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct FromDocument {
+pub(crate) struct FromDocument {
     /// An `fm` document's JSON text.
     pub fm: Option<String>,
     /// An AM approach document's JSON text (its constants are the probe's).
@@ -44,7 +44,7 @@ impl FromDocument {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `fm`.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         match (&self.fm, &self.am) {
             (Some(_), None) | (None, Some(_)) => Ok(()),
             _ => Err(SimError::out_of_range(
@@ -61,7 +61,11 @@ impl FromDocument {
     /// # Errors
     /// As [`FromDocument::validate`]; a text that is not JSON, a document that is not an SI
     /// `fm` document or an AM approach of the point mass; the inversion's errors.
-    pub fn run(&self, model: &Resolved, progress: &Progress) -> Result<(Value, Layout), SimError> {
+    pub(crate) fn run(
+        &self,
+        model: &Resolved,
+        progress: &Progress,
+    ) -> Result<(Value, Layout), SimError> {
         self.validate()?;
         match (&self.fm, &self.am) {
             (Some(fm), _) => {

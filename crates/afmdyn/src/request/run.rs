@@ -9,10 +9,10 @@
 //! `crate::study::basins`, `crate::study::global_continuation` and `crate::study::stepped`).
 //! The two whose results are streams enter through it too: `simulate` streamed to files
 //! ([`crate::request::simulate_stream::SimulateStream`]: recorded in chunks by
-//! [`crate::trajectory::chunked::record_chunked`], its series' bytes held against the files'
+//! `crate::trajectory::chunked::record_chunked`, its series' bytes held against the files'
 //! budget, [`crate::request::analyses::SimulateSpan`]), and `bifurcation`, whose `execute` is
 //! the in-memory sweep; a front end that runs the sweep resumably into a store of its own
-//! ([`crate::study::sweep::SweepStudy`] into a [`crate::request::Checkpoint`]) checks its cost
+//! ([`crate::study::sweep::SweepStudy`] into a `crate::request::Checkpoint`) checks its cost
 //! first by [`admit`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
@@ -106,7 +106,7 @@ pub trait Analysis {
         crate::probe::ProbeNeeds::Oscillation
     }
     /// What the request costs on `model` — peak memory and work in mode-periods
-    /// ([`super::costs`]) — estimated for the worst case its options allow, before any work;
+    /// (`super::costs`) — estimated for the worst case its options allow, before any work;
     /// [`run`] refuses it beyond [`super::limits::MAX_REQUEST_BYTES`] or
     /// [`super::limits::MAX_REQUEST_WORK`]. Called after [`Analysis::validate`].
     ///
@@ -115,7 +115,7 @@ pub trait Analysis {
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError>;
     /// The parameters the result was computed at, for the SI block: `model.params`, unless
     /// the analysis moves them (a resonance curve under a probe is the free resonance,
-    /// [`super::curves::free_resonance_base`]).
+    /// `super::curves::free_resonance_base`).
     ///
     /// # Errors
     /// As the analysis' validation.
@@ -132,7 +132,7 @@ pub trait Analysis {
     }
     /// The largest indentation max(−V_T, 0) of a result that has operating points in contact
     /// (in the model's length unit), which [`document`] holds against the contact law's
-    /// validity under a probe ([`crate::probe::Probe::indentation_warnings`]); `None` (the
+    /// validity under a probe (`crate::probe::Probe::indentation_warnings`); `None` (the
     /// default) for a result without one.
     fn largest_indentation(&self, _output: &Self::Output) -> Option<f64> {
         None
@@ -193,7 +193,7 @@ impl Destination<'_> {
 }
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
-/// budgets ([`check_cost`]), [`Analysis::execute`], then its document with the SI block of the
+/// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
 /// probe ([`report::with_si`]).
 ///
 /// # Errors
@@ -230,11 +230,11 @@ pub fn run_admitted<A: Analysis + ?Sized>(
 }
 
 /// Admit `analysis` on `model` before any work: [`Analysis::validate`], then its
-/// [`Analysis::cost`] held against the budgets ([`check_cost`]) — [`run`]'s first step, and a
+/// [`Analysis::cost`] held against the budgets (`check_cost`) — [`run`]'s first step, and a
 /// front end's for a request it runs itself (a study into its store, a run streamed to files).
 ///
 /// # Errors
-/// A probe that does not serve the request ([`crate::probe::Probe::serves`]); the request's
+/// A probe that does not serve the request (`crate::probe::Probe::serves`); the request's
 /// validation errors; [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(), SimError> {
     validate(analysis, model)?;
@@ -566,7 +566,7 @@ pub struct ApproachRequest {
 
 impl ApproachRequest {
     /// The units of the curve: SI (m, N, J) with a probe, else the model's.
-    pub fn units(model: &Resolved) -> CurveUnits {
+    pub(crate) fn units(model: &Resolved) -> CurveUnits {
         match &model.probe {
             Some(p) => CurveUnits::from_scales(&p.scales, false),
             None => CurveUnits::dimensionless(),
@@ -628,7 +628,7 @@ impl Default for ResonanceRequest {
 
 impl ResonanceRequest {
     /// The units of the curve: SI (m, N, J, Hz) with a probe, else the model's.
-    pub fn units(model: &Resolved) -> CurveUnits {
+    pub(crate) fn units(model: &Resolved) -> CurveUnits {
         match &model.probe {
             Some(p) => CurveUnits::from_scales(&p.scales, true),
             None => CurveUnits::dimensionless(),
@@ -648,7 +648,7 @@ impl ResonanceRequest {
 }
 
 /// `bimodal`: the approach curve of a drive with two or more components
-/// ([`super::curves::check_bimodal`]), its files named `bimodal`; its refusals name
+/// (`super::curves::check_bimodal`), its files named `bimodal`; its refusals name
 /// the approach curve it is.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(transparent)]

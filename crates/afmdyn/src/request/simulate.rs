@@ -13,9 +13,9 @@ use serde::{Deserialize, Serialize};
 /// Where a recorded time series goes, which sets its budget.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SeriesStore {
-    /// Streamed to files in chunks: [`MAX_SERIES_BYTES`] on disk.
+    /// Streamed to files in chunks: `MAX_SERIES_BYTES` on disk.
     Files,
-    /// Held whole in memory (a Python call): [`MAX_SERIES_MEMORY_BYTES`].
+    /// Held whole in memory (a Python call): `MAX_SERIES_MEMORY_BYTES`.
     Memory,
     /// Not kept (only the summary).
     Nothing,
@@ -171,7 +171,7 @@ impl SimulateRequest {
 
 impl SimulateRequest {
     /// [`SimulateRequest::validate`] for a series held whole in memory ([`SeriesStore::Memory`],
-    /// [`SimulateRequest::record_whole`]: τ, V_T, V̇_T, W, Ẇ, contact, force and the state's
+    /// `SimulateRequest::record_whole`: τ, V_T, V̇_T, W, Ẇ, contact, force and the state's
     /// entries per sample, 8 bytes each; Python's arrays, the browser's series).
     ///
     /// # Errors

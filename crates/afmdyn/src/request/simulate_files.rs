@@ -33,7 +33,7 @@ pub(crate) const SERIES_FILES: [&str; 6] = [
 ];
 
 /// The open data files of a run (see the module doc).
-pub struct SeriesFiles {
+pub(crate) struct SeriesFiles {
     su: SeriesUnits,
     npy: NpyStream,
     csv: Option<CsvStream>,
@@ -87,7 +87,12 @@ impl SeriesFiles {
     ///
     /// # Errors
     /// [`FileError`] naming a file that cannot be created.
-    pub fn create(dir: &Path, n: usize, su: SeriesUnits, csv: bool) -> Result<Self, FileError> {
+    pub(crate) fn create(
+        dir: &Path,
+        n: usize,
+        su: SeriesUnits,
+        csv: bool,
+    ) -> Result<Self, FileError> {
         let columns = series_columns(n, &su);
         let names = su.names();
         let time = [
@@ -135,7 +140,7 @@ impl SeriesFiles {
     ///
     /// # Errors
     /// [`FileError`] naming a file that cannot be written.
-    pub fn push(&mut self, model: &CantileverModel, c: &Chunk<'_>) -> Result<(), FileError> {
+    pub(crate) fn push(&mut self, model: &CantileverModel, c: &Chunk<'_>) -> Result<(), FileError> {
         let su = &self.su;
         // dimensionless units and no internal state: the rows as they are (the conversion
         // would multiply by 1)
@@ -210,7 +215,7 @@ impl SeriesFiles {
     ///
     /// # Errors
     /// [`FileError`] naming a file that cannot be finished.
-    pub fn finish(self) -> Result<(), FileError> {
+    pub(crate) fn finish(self) -> Result<(), FileError> {
         self.npy.finish()?;
         if let Some(c) = self.csv {
             csv_finish(c)?;

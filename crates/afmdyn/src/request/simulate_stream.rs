@@ -1,11 +1,11 @@
 //! `simulate` streamed to files ([`SimulateStream`]): the run is recorded in chunks of whole
-//! periods ([`crate::trajectory::chunked::record_chunked`]) and every chunk is written to the
-//! data files ([`super::simulate_files::SeriesFiles`]) as it comes, while what the plots and
+//! periods (`crate::trajectory::chunked::record_chunked`) and every chunk is written to the
+//! data files (`super::simulate_files::SeriesFiles`) as it comes, while what the plots and
 //! the spectrum need is gathered in bounded memory ([`PlotData`]); memory does not grow with
 //! the length of the run. Its [`Analysis`] checks the series' bytes against the files' budget
 //! ([`SeriesStore::Files`]) and the run's cost before any work; `execute` is the run itself
 //! (it writes the data files into `dir`), `present` the spectrum, the figures and the summary
-//! (its presentation, [`simulate`], is here too).
+//! (its presentation, `simulate`, is here too).
 
 use super::analyses::{initial_state, SeriesStore, SimulateRequest, SimulateSpan};
 use super::costs::{state_bytes, MODEL_BYTES};
@@ -31,10 +31,10 @@ use std::collections::VecDeque;
 use std::path::PathBuf;
 
 /// Samples kept for the phase portrait (the last ones).
-pub const PHASE_SAMPLES: usize = 50_000;
+pub(crate) const PHASE_SAMPLES: usize = 50_000;
 /// Drive periods `tip.png` shows (the last ones) when more were recorded; `tip-all.png` then
 /// shows every recorded period (a 50-period chaotic record drawn whole is unreadable).
-pub const TIP_WINDOW_PERIODS: usize = 10;
+pub(crate) const TIP_WINDOW_PERIODS: usize = 10;
 /// Pixel columns of the tip plots' grid, on which their lines are decimated as they come.
 const TIP_COLUMNS: f64 = 2000.0;
 
@@ -63,7 +63,7 @@ pub struct SimulateRecording {
     pub transient_tau: f64,
     /// The run: its end, final state, switchings, sections and energy balance.
     pub summary: SimulateSummary,
-    /// The last [`SPECTRUM_SAMPLES`] values of W(1,τ) (with files).
+    /// The last `SPECTRUM_SAMPLES` values of W(1,τ) (with files).
     pub spectrum: Vec<f64>,
     /// The plots' data (with figures).
     pub plots: Option<PlotData>,
@@ -257,9 +257,9 @@ pub struct PlotData {
     pub t1: f64,
     /// The contact intervals.
     pub shade: Shade,
-    /// The last [`PHASE_SAMPLES`]: τ, V_T, ∂W(1,τ)/∂τ (dV_T/dτ formed at the end).
+    /// The last `PHASE_SAMPLES`: τ, V_T, ∂W(1,τ)/∂τ (dV_T/dτ formed at the end).
     pub phase: VecDeque<(f64, f64, f64)>,
-    /// The last [`TIP_WINDOW_PERIODS`] periods: τ, W(1,τ), V_T, in contact.
+    /// The last `TIP_WINDOW_PERIODS` periods: τ, W(1,τ), V_T, in contact.
     pub recent: VecDeque<(f64, f64, f64, bool)>,
     /// Its capacity (samples).
     recent_cap: usize,
@@ -372,7 +372,7 @@ impl PlotData {
 ///
 /// # Errors
 /// [`SimError`] when the model cannot be built.
-pub fn simulate(
+pub(crate) fn simulate(
     run: &SimulateStream,
     model: &Resolved,
     r: &SimulateRecording,

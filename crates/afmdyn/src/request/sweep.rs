@@ -4,12 +4,13 @@
 //!
 //! A point gives one row per Poincaré point of its steady state (one row when it failed). The
 //! rows of a finished sweep are ordered by value index, then branch (forward, backward,
-//! start 0, 1, …), then Poincaré point ([`order_key`]), whatever order the workers finished in.
-//! The command line writes them as `bifurcation.csv` ([`SweepRecord::csv_line`], [`HEADER`]);
+//! start 0, 1, …), then Poincaré point (`order_key`), whatever order the workers finished in.
+//! The command line writes them as `bifurcation.csv` (`SweepRecord::csv_line`, `HEADER`);
 //! Python returns them as columns.
 
 use super::analyses::BifurcationRequest;
 use crate::analysis::bifurcation::{Branch, SweepPoint, SweepSpec};
+#[cfg(feature = "files")]
 use crate::layout::{Layout, Values, Variable};
 use crate::params::SweepParam;
 use serde_json::{json, Value};
@@ -105,7 +106,7 @@ pub const COLUMNS: [RecordColumn; 18] = [
 ];
 
 /// The records as numbers (the command line's `bifurcation.npy`): the numeric columns of
-/// [`COLUMNS`] with the branch ([`branch_code`]) and the status ([`PointStatus::code`]) as codes.
+/// [`COLUMNS`] with the branch (`branch_code`) and the status ([`PointStatus::code`]) as codes.
 pub const NUMERIC_COLUMNS: [RecordColumn; 12] = [
     COLUMNS[COL_VALUE],
     COLUMNS[COL_INDEX],
@@ -130,7 +131,8 @@ pub const NUMERIC_COLUMNS: [RecordColumn; 12] = [
 ];
 
 /// The CSV header: the names of [`COLUMNS`].
-pub const HEADER: [&str; 18] = {
+#[cfg(any(test, feature = "files"))]
+pub(crate) const HEADER: [&str; 18] = {
     let mut h = [""; 18];
     let mut i = 0;
     while i < 18 {
@@ -144,7 +146,8 @@ pub const HEADER: [&str; 18] = {
 /// rule of `docs/outputs.md`: a sweep with no answer is a failure), else `None`; from the
 /// counts of its points (the first row of each, `point` = 0) computed and failed, and the
 /// first failure's message.
-pub fn sweep_failure(
+#[cfg(feature = "files")]
+pub(crate) fn sweep_failure(
     computed: usize,
     failed: usize,
     first: Option<&str>,
@@ -160,7 +163,8 @@ pub fn sweep_failure(
 }
 
 /// [`sweep_failure`] of a sweep's `records`.
-pub fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
+#[cfg(feature = "files")]
+pub(crate) fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
     let points = records.iter().filter(|r| r.point == 0);
     let (failed, computed): (Vec<&SweepRecord>, Vec<&SweepRecord>) =
         points.partition(|r| r.status == PointStatus::Error);
@@ -176,15 +180,19 @@ pub const COL_VALUE: usize = 1;
 /// Position of `index`.
 pub(crate) const COL_INDEX: usize = 2;
 /// Position of `branch`.
-pub const COL_BRANCH: usize = 3;
+#[cfg(any(test, feature = "files"))]
+pub(crate) const COL_BRANCH: usize = 3;
 /// Position of `status`.
-pub const COL_STATUS: usize = 4;
+#[cfg(any(test, feature = "files"))]
+pub(crate) const COL_STATUS: usize = 4;
 /// Position of `period`.
-pub const COL_PERIOD: usize = 5;
+#[cfg(any(test, feature = "files"))]
+pub(crate) const COL_PERIOD: usize = 5;
 /// Position of `point`.
 pub(crate) const COL_POINT: usize = 6;
 /// Position of `points`.
-pub const COL_POINTS: usize = 7;
+#[cfg(any(test, feature = "files"))]
+pub(crate) const COL_POINTS: usize = 7;
 /// Position of `tau`.
 pub(crate) const COL_TAU: usize = 8;
 /// Position of `w_tip`.
@@ -192,12 +200,15 @@ pub const COL_W_TIP: usize = 10;
 /// Position of `x_max`.
 pub(crate) const COL_X_MAX: usize = 11;
 /// Position of `message`.
-pub const COL_MESSAGE: usize = 16;
+#[cfg(feature = "files")]
+pub(crate) const COL_MESSAGE: usize = 16;
 /// Position of `state`.
-pub const COL_STATE: usize = 17;
+#[cfg(any(test, feature = "files"))]
+pub(crate) const COL_STATE: usize = 17;
 
 /// The numeric code of a branch: 0 forward, 1 backward, 2 + k random start k.
-pub fn branch_code(b: Branch) -> f64 {
+#[cfg(any(test, feature = "files"))]
+pub(crate) fn branch_code(b: Branch) -> f64 {
     match b {
         Branch::Forward => 0.0,
         Branch::Backward => 1.0,
@@ -238,7 +249,8 @@ impl PointStatus {
 
 /// The numeric code of the `status` and `period` cells of a CSV row: the period n, −1
 /// nonperiodic, −2 anything else; NaN for `periodic` without a readable period.
-pub fn status_code(status: &str, period: &str) -> f64 {
+#[cfg(feature = "files")]
+pub(crate) fn status_code(status: &str, period: &str) -> f64 {
     match status {
         "periodic" => period.parse().unwrap_or(f64::NAN),
         "nonperiodic" => -1.0,
@@ -287,7 +299,7 @@ pub struct SweepRecord {
 }
 
 /// The records of a point, one per Poincaré point (one for a failed point), in order.
-pub fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
+pub(crate) fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
     let base = |status, point, points| SweepRecord {
         param,
         value: p.value,
@@ -344,7 +356,8 @@ pub fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
 /// `point`), `n_points` (`points`), `tau` … `contacts_per_period`, `transient_periods` (−1 for
 /// a failed point), `message` — and the state as `a_1` … `a_N`, `a_dot_1` … `a_dot_N` (NaN
 /// for a failed point).
-pub fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
+#[cfg(feature = "files")]
+pub(crate) fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
     // a number's unit and meaning as the numeric columns give them (`period` as its code),
     // a word's as the CSV's
     let meaning = |name: &str, numeric: bool| {
@@ -432,14 +445,15 @@ pub fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
 }
 
 /// The position of a record in the one row order: (value index, branch, Poincaré point).
-pub fn order_key(r: &SweepRecord) -> (usize, Branch, usize) {
+pub(crate) fn order_key(r: &SweepRecord) -> (usize, Branch, usize) {
     (r.index, r.branch, r.point)
 }
 
 impl SweepRecord {
     /// The row as a CSV line of [`HEADER`]'s columns, without its newline (numbers in Rust's
     /// shortest round-trip form, empty cells for what a failed point lacks).
-    pub fn csv_line(&self) -> String {
+    #[cfg(any(test, feature = "files"))]
+    pub(crate) fn csv_line(&self) -> String {
         let num = |v: f64| {
             if self.status == PointStatus::Error {
                 String::new()
@@ -480,7 +494,8 @@ impl SweepRecord {
     ///
     /// # Errors
     /// A message naming the column that cannot be read.
-    pub fn parse_csv(line: &str) -> Result<SweepRecord, String> {
+    #[cfg(any(test, feature = "files"))]
+    pub(crate) fn parse_csv(line: &str) -> Result<SweepRecord, String> {
         let c: Vec<&str> = line.split(',').collect();
         if c.len() != HEADER.len() {
             return Err(format!("{} cells, expected {}", c.len(), HEADER.len()));
@@ -533,7 +548,7 @@ impl SweepRecord {
 /// is resumed only with the same fingerprint. The worker threads are not part of it.
 ///
 /// The values are `from`, `to`, `steps`, or `values` when the request lists them.
-pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
+pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
     let mut doc = json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         // how the sweep is cut into tasks and its starts keyed (issue 29): a store written by

@@ -4,8 +4,8 @@
 //! each pass begins with the attractors and the coarse grid of the passes before it
 //! ([`run_passes`] merges the stored rows in their place, so a resumed map is the
 //! uninterrupted one). The map is assembled from the records by [`basin_map`], whatever store
-//! kept them: [`MemoryStore`](super::MemoryStore) for a run that writes no files, the
-//! directory store [`basin_store`] (feature `files`) for `afmdyn basins --out DIR`, resumable.
+//! kept them: `MemoryStore` for a run that writes no files, the
+//! directory store `basin_store` (feature `files`) for `afmdyn basins --out DIR`, resumable.
 //!
 //! The request's [`Analysis`] (`request::run`, Python's `afmdyn.basins`) runs this study in
 //! memory.
@@ -32,13 +32,13 @@ pub struct BasinStudy {
     pub spec: BasinSpec,
     /// The cantilever of `spec.params`.
     pub model: CantileverModel,
-    /// What a resumed map must match ([`fingerprint`]).
+    /// What a resumed map must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a basin map: everything that determines its cells (the library's
 /// version, the model values, every option of the request but the threads).
-pub fn fingerprint(request: &BasinsRequest, params: &Params) -> Value {
+pub(crate) fn fingerprint(request: &BasinsRequest, params: &Params) -> Value {
     let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
     if let Some(map) = r.as_object_mut() {
         map.remove("threads");
@@ -56,7 +56,7 @@ impl BasinStudy {
     /// # Errors
     /// As [`BasinsRequest::spec`]; [`SimError::Budget`] beyond the budgets of a request
     /// ([`check_cost`]).
-    pub fn new(request: &BasinsRequest, params: &Params) -> Result<BasinStudy, SimError> {
+    pub(crate) fn new(request: &BasinsRequest, params: &Params) -> Result<BasinStudy, SimError> {
         let spec = request.spec(params)?;
         // held to the budgets here too: a front end runs the study into its store without
         // `run`
@@ -70,7 +70,7 @@ impl BasinStudy {
     }
 
     /// The number of task `row` (its pass and row index).
-    pub fn task(&self, row: &BasinRow) -> usize {
+    pub(crate) fn task(&self, row: &BasinRow) -> usize {
         row.pass * self.spec.ys.len() + row.iy
     }
 
@@ -145,13 +145,13 @@ impl Analysis for BasinsRequest {
 /// `.basins.rows.jsonl` (one checksummed line per finished row, under `"row"`), as
 /// [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
-pub mod store {
+pub(crate) mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::basins::BasinRow;
     use crate::io::dir_lock::DirLock;
 
     /// The basin map's files.
-    pub const BASIN_FILES: TaskFiles = TaskFiles {
+    pub(crate) const BASIN_FILES: TaskFiles = TaskFiles {
         ledger: ".basins.run.json",
         records: ".basins.rows.jsonl",
         key: "row",
@@ -160,13 +160,13 @@ pub mod store {
     };
 
     /// A basin map's store: its rows by task.
-    pub type BasinStore<'a> = TaskStore<'a, BasinRow>;
+    pub(crate) type BasinStore<'a> = TaskStore<'a, BasinRow>;
 
     /// The basin store of the directory `lock` holds.
-    pub fn basin_store(lock: &DirLock) -> BasinStore<'_> {
+    pub(crate) fn basin_store(lock: &DirLock) -> BasinStore<'_> {
         TaskStore::new(lock, BASIN_FILES).keeping()
     }
 }
 
 #[cfg(feature = "files")]
-pub use store::{basin_store, BasinStore, BASIN_FILES};
+pub(crate) use store::basin_store;

@@ -79,7 +79,7 @@ impl Analysis for Chart {
 
 /// The cells of the tasks `records` (a [`super::MemoryStore`]'s, in any order), row
 /// by row, x increasing.
-pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
+pub(crate) fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
     let mut cells: Vec<ChartCell> = records.into_iter().flat_map(|(_, c)| c).collect();
     cells.sort_by_key(|c| (c.iy, c.ix));
     cells

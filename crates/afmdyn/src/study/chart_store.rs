@@ -1,7 +1,7 @@
-//! The resumable store of a chart (feature `files`): a [`TaskStore`] of tiles in the directory
+//! The resumable store of a chart (feature `files`): a `TaskStore` of tiles in the directory
 //! `afmdyn chart --out DIR` names — `.chart.run.json` (the ledger) and `.chart.tiles.jsonl`
 //! (one checksummed line per finished tile, its cells under `"cells"`), as
-//! [`super::task_store`] describes.
+//! `super::task_store` describes.
 
 use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
@@ -20,6 +20,6 @@ pub(crate) const CHART_FILES: TaskFiles = TaskFiles {
 pub(crate) type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
 
 /// The chart store of the directory `lock` holds.
-pub fn chart_store(lock: &DirLock) -> ChartStore<'_> {
+pub(crate) fn chart_store(lock: &DirLock) -> ChartStore<'_> {
     TaskStore::new(lock, CHART_FILES)
 }

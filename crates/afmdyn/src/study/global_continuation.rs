@@ -3,9 +3,9 @@
 //! values; its record the value's step (its attractors with their ids); the tasks form one
 //! chain — each value's census is seeded from the previous value's attractors and its ids
 //! matched to them — so what a resume skips is the stored steps themselves, and the chain goes
-//! on after the last ([`continue_values`]), to the steps of an uninterrupted run. Stored by
-//! [`MemoryStore`](super::MemoryStore) for a run that writes no files, by the directory store
-//! [`continuation_store`] (feature `files`) for `afmdyn attractors --sweep --out DIR`,
+//! on after the last (`continue_values`), to the steps of an uninterrupted run. Stored by
+//! `MemoryStore` for a run that writes no files, by the directory store
+//! `continuation_store` (feature `files`) for `afmdyn attractors --sweep --out DIR`,
 //! resumable.
 //!
 //! The request's [`Analysis`] (`request::run`, Python's `afmdyn.global_continuation`) runs
@@ -32,13 +32,13 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 pub struct ContinuationStudy {
     /// The validated continuation.
     pub spec: GlobalContinuationSpec,
-    /// What a resumed continuation must match ([`fingerprint`]).
+    /// What a resumed continuation must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a global continuation: everything that determines its steps (the
 /// library's version, the model values, every option of the request).
-pub fn fingerprint(request: &GlobalContinuationRequest, params: &Params) -> Value {
+pub(crate) fn fingerprint(request: &GlobalContinuationRequest, params: &Params) -> Value {
     json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         "global_continuation": request,
@@ -52,7 +52,7 @@ impl ContinuationStudy {
     /// # Errors
     /// As [`GlobalContinuationRequest::spec`]; [`SimError::Budget`] beyond the budgets of a request
     /// ([`check_cost`]).
-    pub fn new(
+    pub(crate) fn new(
         request: &GlobalContinuationRequest,
         params: &Params,
     ) -> Result<ContinuationStudy, SimError> {
@@ -145,13 +145,13 @@ impl Analysis for GlobalContinuationRequest {
 /// `.continuation.values.jsonl` (one checksummed line per value, its step in CBOR under
 /// `"step"`), as [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
-pub mod store {
+pub(crate) mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::global_continuation::ContinuationStep;
     use crate::io::dir_lock::DirLock;
 
     /// The global continuation's files.
-    pub const CONTINUATION_FILES: TaskFiles = TaskFiles {
+    pub(crate) const CONTINUATION_FILES: TaskFiles = TaskFiles {
         ledger: ".continuation.run.json",
         records: ".continuation.values.jsonl",
         key: "step",
@@ -160,13 +160,13 @@ pub mod store {
     };
 
     /// A global continuation's store: its steps by value.
-    pub type ContinuationStore<'a> = TaskStore<'a, ContinuationStep>;
+    pub(crate) type ContinuationStore<'a> = TaskStore<'a, ContinuationStep>;
 
     /// The continuation store of the directory `lock` holds.
-    pub fn continuation_store(lock: &DirLock) -> ContinuationStore<'_> {
+    pub(crate) fn continuation_store(lock: &DirLock) -> ContinuationStore<'_> {
         TaskStore::new(lock, CONTINUATION_FILES).keeping()
     }
 }
 
 #[cfg(feature = "files")]
-pub use store::{continuation_store, ContinuationStore, CONTINUATION_FILES};
+pub(crate) use store::continuation_store;

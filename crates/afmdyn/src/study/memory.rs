@@ -6,7 +6,7 @@ use crate::request::checkpoint::CheckpointError;
 /// The finished tasks of one run, in the order they finished (a memory store never resumes:
 /// every run begins anew). The records are put in the study's one order by their consumer.
 #[derive(Debug, Clone, PartialEq)]
-pub struct MemoryStore<R> {
+pub(crate) struct MemoryStore<R> {
     /// The finished tasks.
     pub records: Vec<R>,
 }

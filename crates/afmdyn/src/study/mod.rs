@@ -8,13 +8,13 @@
 //! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
 //!   appends a finished task, and finishes atomically (the files in the one order); the file
 //!   stores lock their directory for one run at a time
-//!   ([`crate::request::checkpoint_file::FileCheckpoint`] for sweeps; `task_store::TaskStore`,
+//!   (`crate::request::checkpoint_file::FileCheckpoint` for sweeps; `task_store::TaskStore`,
 //!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `chart_store`; a PI-scanned image's lines, `scan_store`); [`MemoryStore`] keeps the tasks
+//!   `chart_store`; a PI-scanned image's lines, `scan_store`); `MemoryStore` keeps the tasks
 //!   in memory.
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
-//!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
+//!   `crate::request::limits::check_threads`), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
 //! - [`plan`] (feature `files`): the studies as stages of tasks for an executor outside the
 //!   library (Dask), each rebuilt from its recipe, with its ledger.
@@ -26,7 +26,7 @@
 //!   [`global_continuation`] (a global continuation's values, its store
 //!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance curve's
 //!   points, one chain through both sweeps, its store `stepped::curve_store`) and
-//!   [`peakforce`] (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
+//!   `peakforce` (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
 //!   sweep's points, its branches continued across them, stored by the request layer's
 //!   checkpoints). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
@@ -44,25 +44,25 @@ pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
 pub mod global_continuation;
-pub mod image;
+pub(crate) mod image;
 mod kinds;
 mod memory;
-pub mod peakforce;
+pub(crate) mod peakforce;
 pub mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
 pub mod scan;
 #[cfg(feature = "files")]
-pub mod scan_store;
+pub(crate) mod scan_store;
 pub mod stepped;
 #[cfg(feature = "files")]
 pub mod stored;
 pub mod sweep;
 #[cfg(feature = "files")]
-pub mod task_store;
+pub(crate) mod task_store;
 
 pub(crate) use kinds::{in_order, Chain, Tasks};
-pub use memory::MemoryStore;
+pub(crate) use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -76,7 +76,7 @@ use thiserror::Error;
 /// resumes from, whose every task starts from the one before it (a stepped curve). The tasks
 /// after a gap (a store with a line removed) are run again rather than shifted into its place.
 #[derive(Debug, Clone)]
-pub struct Prefix<R>(pub Vec<R>);
+pub(crate) struct Prefix<R>(pub Vec<R>);
 
 impl<R> Default for Prefix<R> {
     fn default() -> Self {
@@ -265,7 +265,7 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
 /// # Errors
 /// [`SimError::Cancelled`] when the observer's flag stopped the run; the pool's errors and the
 /// study's ([`Study::run`]).
-pub fn execute_in_memory<S: Study + ?Sized>(
+pub(crate) fn execute_in_memory<S: Study + ?Sized>(
     study: &S,
     threads: Option<usize>,
     observer: &dyn Observer,

@@ -32,7 +32,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A PeakForce sweep, its study a `Chain` (see the module doc).
 #[derive(Debug, Clone)]
-pub struct PeakForceStudy {
+pub(crate) struct PeakForceStudy {
     /// The model of every value, in the order of the sweep.
     pub points: Vec<Params>,
     /// The peak force the ideal feedback holds at every value (F̃), or `None` (the points' own

@@ -2,16 +2,16 @@
 //! `afmdyn.dask`), which ships each task to a worker as text and hands the results back:
 //! [`Plan`]. A plan is rebuilt in any process from its recipe ([`Recipe`], JSON text), so it
 //! travels to workers as a few hundred bytes; a task's start and result travel as CBOR text
-//! ([`to_cbor_text`]: every float bit for bit), so a study run on a cluster equals the one run
+//! (`to_cbor_text`: every float bit for bit), so a study run on a cluster equals the one run
 //! here ([`super::execute`]) bit for bit.
 //!
 //! - a bifurcation sweep: stage 0 the two coarse continuation passes, stage 1 the chain
 //!   segments and random starts seeded by them ([`SweepPlan`]); with a store, the command
 //!   line's resumable one ([`Plan::store`], [`PlanStore`]);
 //! - a basin map: one stage per pass, whose start is the attractors and coarse grid of the
-//!   passes before it ([`pass_start`]), one task per row;
+//!   passes before it (`pass_start`), one task per row;
 //! - a PI-scanned image: one stage, one task per line ([`ScanStudy`]), whose start is what a
-//!   line needs ([`LineJob`]): a worker scans lines without building the study (the
+//!   line needs (`LineJob`): a worker scans lines without building the study (the
 //!   materials' approach curves, each several lines' time);
 //! - a PeakForce image: stage 0 the materials' engages from far, one task each; stage 1 the
 //!   lines, one task each, whose start is the engages ([`PeakForceImageStudy`]).
@@ -223,7 +223,7 @@ fn plan_of(recipe: Recipe, eager: bool) -> Result<Box<dyn Plan>, SimError> {
 
 /// The plan of a recipe's text ([`Plan::recipe`]), as a worker rebuilds it: a PI image's
 /// study is built on first use, which a worker given the stage's start never makes (its lines
-/// run from the start, [`crate::request::image_scan::LineJob`]).
+/// run from the start, `crate::request::image_scan::LineJob`).
 ///
 /// # Errors
 /// Text that is not a recipe; as [`plan`] (a PI image's study's errors when first used).

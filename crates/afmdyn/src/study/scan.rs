@@ -20,7 +20,7 @@ impl ScanStudy {
 /// `threads` worker threads (`None`: all cores) with progress and cancellation in `observer`.
 ///
 /// # Errors
-/// As [`ScanStudy::new`] and the lines; [`SimError::Cancelled`].
+/// As `ScanStudy::new` and the lines; [`SimError::Cancelled`].
 pub fn pi_image(
     probe_table: &toml::Table,
     map: &SampleMap,

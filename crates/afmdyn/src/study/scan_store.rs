@@ -22,6 +22,6 @@ pub(crate) const SCAN_FILES: TaskFiles = TaskFiles {
 pub(crate) type ScanStore<'a> = TaskStore<'a, ScanLine>;
 
 /// The scan store of the directory `lock` holds.
-pub fn scan_store(lock: &DirLock) -> ScanStore<'_> {
+pub(crate) fn scan_store(lock: &DirLock) -> ScanStore<'_> {
     TaskStore::new(lock, SCAN_FILES)
 }

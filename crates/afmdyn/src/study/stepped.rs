@@ -3,11 +3,11 @@
 //! first sweep (approach, up-sweep) and n..2n along the sweep back; the points form one chain
 //! — each is stepped from the orbit before it (its state, the secant or quadratic predictor
 //! through the points before, the monodromy trend) — so what a resume skips is the stored
-//! points themselves, and the chain goes on after the last ([`sweep_points`]), to the points
+//! points themselves, and the chain goes on after the last (`sweep_points`), to the points
 //! of an uninterrupted run. The branches, folds, jumps and traces are computed from the two
-//! sweeps when the curve is assembled ([`CurveStudy::curve`], [`finish_curve`]): they are not
-//! tasks. Stored by [`MemoryStore`](super::MemoryStore) for a run that writes no files, by the
-//! directory store [`curve_store`] (feature `files`) for `afmdyn approach|resonance --out
+//! sweeps when the curve is assembled ([`CurveStudy::curve`], `finish_curve`): they are not
+//! tasks. Stored by `MemoryStore` for a run that writes no files, by the
+//! directory store `curve_store` (feature `files`) for `afmdyn approach|resonance --out
 //! DIR`, resumable.
 //!
 //! The requests' [`Analysis`] (`request::run`, Python's `afmdyn.approach` and
@@ -37,13 +37,13 @@ use serde_json::{json, Value};
 pub struct CurveStudy {
     /// The validated sweep.
     pub spec: SteppedSpec,
-    /// What a resumed curve must match ([`fingerprint`]).
+    /// What a resumed curve must match (`fingerprint`).
     pub fingerprint: Value,
 }
 
 /// The fingerprint of a stepped curve: everything that determines its points (the library's
 /// version, the kind of curve and its request, the model values and the probe).
-pub fn fingerprint(kind: &str, request: &impl Serialize, model: &Resolved) -> Value {
+pub(crate) fn fingerprint(kind: &str, request: &impl Serialize, model: &Resolved) -> Value {
     json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
         kind: request,
@@ -57,8 +57,8 @@ impl CurveStudy {
     /// The study of the approach curve `request` on `model`.
     ///
     /// # Errors
-    /// As [`ApproachRequest::spec`] and [`check_values`]; [`SimError::Budget`] beyond the
-    /// budgets of a request ([`check_cost`]).
+    /// As [`ApproachRequest::spec`] and `check_values`; [`SimError::Budget`] beyond the
+    /// budgets of a request (`check_cost`).
     pub fn approach(request: &ApproachRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
             "approach",
@@ -72,7 +72,10 @@ impl CurveStudy {
     /// # Errors
     /// As [`ResonanceRequest::spec`] and [`check_values`]; [`SimError::Budget`] beyond the
     /// budgets of a request ([`check_cost`]).
-    pub fn resonance(request: &ResonanceRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
+    pub(crate) fn resonance(
+        request: &ResonanceRequest,
+        model: &Resolved,
+    ) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
             "resonance",
             request.spec(model)?,
@@ -100,11 +103,11 @@ impl CurveStudy {
 
     /// The curve of a finished study's records (in any order): the two sweeps, then the
     /// branches (their points counted in `progress`), folds, jumps and traces
-    /// ([`finish_curve`]).
+    /// (`finish_curve`).
     ///
     /// # Errors
     /// [`SimError::Cancelled`] when a point is missing (a run that was cut short) or once
-    /// `progress` is cancelled; as [`finish_curve`].
+    /// `progress` is cancelled; as `finish_curve`.
     pub fn curve(
         &self,
         records: impl IntoIterator<Item = (usize, CurvePoint)>,
@@ -240,13 +243,13 @@ impl Analysis for ResonanceRequest {
 /// `.curve.points.jsonl` (one checksummed line per point, in CBOR under `"point"`), as
 /// [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
-pub mod store {
+pub(crate) mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::stepped::CurvePoint;
     use crate::io::dir_lock::DirLock;
 
     /// A stepped curve's files.
-    pub const CURVE_FILES: TaskFiles = TaskFiles {
+    pub(crate) const CURVE_FILES: TaskFiles = TaskFiles {
         ledger: ".curve.run.json",
         records: ".curve.points.jsonl",
         key: "point",
@@ -255,16 +258,16 @@ pub mod store {
     };
 
     /// A stepped curve's store: its points by place.
-    pub type CurveStore<'a> = TaskStore<'a, CurvePoint>;
+    pub(crate) type CurveStore<'a> = TaskStore<'a, CurvePoint>;
 
     /// The curve store of the directory `lock` holds.
-    pub fn curve_store(lock: &DirLock) -> CurveStore<'_> {
+    pub(crate) fn curve_store(lock: &DirLock) -> CurveStore<'_> {
         TaskStore::new(lock, CURVE_FILES).keeping()
     }
 }
 
 #[cfg(feature = "files")]
-pub use store::{curve_store, CurveStore, CURVE_FILES};
+pub(crate) use store::curve_store;
 
 /// A warning when an approach over the default range
 /// ([`crate::analysis::approach::default_range`]) never brought the amplitude down to 0.5 A₀:

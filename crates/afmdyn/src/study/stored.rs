@@ -5,7 +5,7 @@
 //! by name ([`parse`]: `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`,
 //! `resonance`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
 //! ([`Prepared::run`]) to the outcome the one door gives for the same request
-//! ([`crate::request::named::outcome`]).
+//! (`crate::request::named::outcome`).
 
 use super::basins::{basin_store, BasinStudy};
 use super::chart::cells_of;
@@ -314,7 +314,7 @@ impl Resumable for ImageJob {
 
 /// `bifurcation` into the files of its store (`afmdyn bifurcation --out DIR`): the sweep run
 /// resumably into the directory's checkpoint, then tallied, its NPY written and its diagrams
-/// streamed from the finished rows' CSV ([`SweepFiles`]), so that memory does not grow with
+/// streamed from the finished rows' CSV (`SweepFiles`), so that memory does not grow with
 /// the sweep. It runs only into a directory.
 #[derive(Debug, Clone)]
 pub struct SweepInto(pub BifurcationRequest);

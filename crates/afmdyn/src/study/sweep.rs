@@ -25,7 +25,7 @@ use std::sync::atomic::AtomicBool;
 pub struct SweepStudy {
     /// The validated sweep.
     pub spec: SweepSpec,
-    /// What a resumed sweep must match ([`crate::request::sweep::fingerprint`]).
+    /// What a resumed sweep must match (`crate::request::sweep::fingerprint`).
     pub fingerprint: Value,
 }
 
@@ -76,8 +76,8 @@ impl Study for SweepStudy {
 }
 
 /// A bifurcation sweep through the one door ([`crate::request::run()`]): its cost checked
-/// before any work, its records computed in memory ([`super::execute_in_memory`]) and put in
-/// the one order ([`crate::request::sweep::order_key`]). A front end that runs the sweep
+/// before any work, its records computed in memory (`super::execute_in_memory`) and put in
+/// the one order (`crate::request::sweep::order_key`). A front end that runs the sweep
 /// resumably into a store of its own (`afmdyn bifurcation --out DIR`) checks the same cost
 /// first ([`crate::request::run::admit`]) and runs the [`SweepStudy`] itself.
 impl Analysis for BifurcationRequest {

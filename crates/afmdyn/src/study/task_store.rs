@@ -45,7 +45,7 @@ const CRC_KEY: &str = ",\"crc32\":\"";
 
 /// The files and keys of one kind of study's store.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TaskFiles {
+pub(crate) struct TaskFiles {
     /// The ledger's file name.
     pub ledger: &'static str,
     /// The records' file name.
@@ -61,7 +61,7 @@ pub struct TaskFiles {
 
 /// How a store's line holds its record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Encoding {
+pub(crate) enum Encoding {
     /// JSON (readable; for records whose floats are all finite: JSON has no NaN or ±∞).
     Json,
     /// A string: the record's CBOR encoding (RFC 8949, by `ciborium`) in standard base64 —
@@ -72,7 +72,7 @@ pub enum Encoding {
 
 /// A study's store of records `R` in the directory its lock holds.
 #[derive(Debug)]
-pub struct TaskStore<'a, R> {
+pub(crate) struct TaskStore<'a, R> {
     files: TaskFiles,
     lock: &'a DirLock,
     writer: Option<BufWriter<File>>,
@@ -86,7 +86,7 @@ pub struct TaskStore<'a, R> {
 
 impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// The store of the directory `lock` holds, in `files`.
-    pub fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
+    pub(crate) fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
         TaskStore {
             files,
             lock,
@@ -101,7 +101,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// hands them back without reading and decoding the file again — for a study whose
     /// records a resume reads anyway (a chain's: [`StoredTasks`] for `Vec<R>`), not for one
     /// whose records must stay on disk.
-    pub fn keeping(mut self) -> TaskStore<'a, R> {
+    pub(crate) fn keeping(mut self) -> TaskStore<'a, R> {
         self.kept = Some((BTreeMap::new(), false));
         self
     }
@@ -146,7 +146,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// # Errors
     /// [`CheckpointError::Mismatch`] naming the first field that differs,
     /// [`CheckpointError::Unrecorded`] for tasks without a ledger, and the files' errors.
-    pub fn open(
+    pub(crate) fn open(
         &mut self,
         fingerprint: &Value,
         resume: bool,
@@ -286,7 +286,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`].
-    pub fn append(&mut self, task: usize, record: &R) -> Result<(), CheckpointError> {
+    pub(crate) fn append(&mut self, task: usize, record: &R) -> Result<(), CheckpointError> {
         let path = self.path(self.files.records);
         let mut line = serde_json::Map::new();
         line.insert("task".into(), json!(task));
@@ -318,7 +318,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`].
-    pub fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
+    pub(crate) fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
         if let Some(w) = self.writer.as_mut() {
             let path = self.lock.path().join(self.files.records);
             w.flush().map_err(io("write", &path))?;
@@ -330,7 +330,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// As the ledger's reading.
-    pub fn finished(&self) -> Result<bool, CheckpointError> {
+    pub(crate) fn finished(&self) -> Result<bool, CheckpointError> {
         Ok(self.ledger()?.is_some_and(|l| l.finished))
     }
 
@@ -338,7 +338,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ///
     /// # Errors
     /// [`CheckpointError::Io`]; [`CheckpointError::Corrupt`] for a damaged line.
-    pub fn records(&mut self) -> Result<Vec<(usize, R)>, CheckpointError> {
+    pub(crate) fn records(&mut self) -> Result<Vec<(usize, R)>, CheckpointError> {
         if let Some(w) = self.writer.as_mut() {
             let path = self.lock.path().join(self.files.records);
             w.flush().map_err(io("write", &path))?;
@@ -362,7 +362,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
 ///
 /// # Errors
 /// The encoder's message.
-pub fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> {
+pub(crate) fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> {
     let mut bytes = Vec::new();
     ciborium::into_writer(value, &mut bytes).map_err(|e| e.to_string())?;
     Ok(BASE64.encode(bytes))
@@ -381,7 +381,7 @@ pub(crate) fn from_cbor_text<T: DeserializeOwned>(text: &str) -> Result<T, Strin
 /// (`HashSet<usize>`: their records stay in the file, memory does not grow with the study) or
 /// the records themselves in the order of the tasks (`Vec<R>`: a study whose later tasks start
 /// from the earlier ones' results, as a basin map's passes do).
-pub trait StoredTasks<R>: Sized {
+pub(crate) trait StoredTasks<R>: Sized {
     /// Read from `store`, just opened, whose stored tasks are `tasks`.
     ///
     /// # Errors

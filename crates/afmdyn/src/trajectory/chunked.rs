@@ -11,13 +11,13 @@ use crate::integrate::{Integrator, SwitchEvent};
 use nalgebra::DVector;
 
 /// Samples held in memory at once by default (a chunk of the run).
-pub const CHUNK_SAMPLES: usize = 65_536;
+pub(crate) const CHUNK_SAMPLES: usize = 65_536;
 /// Drive periods of a chunk when no samples are kept.
-pub const CHUNK_PERIODS_WITHOUT_SAMPLES: usize = 4096;
+pub(crate) const CHUNK_PERIODS_WITHOUT_SAMPLES: usize = 4096;
 
 /// What to record, in chunks.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChunkedSpec {
+pub(crate) struct ChunkedSpec {
     /// Drive periods run and discarded first.
     pub transient_periods: f64,
     /// Length of the recorded part, in τ.
@@ -31,7 +31,7 @@ pub struct ChunkedSpec {
 
 /// One finished chunk: the new samples, switchings, section points and energy balances.
 #[derive(Debug)]
-pub struct Chunk<'a> {
+pub(crate) struct Chunk<'a> {
     /// Whether this is the first chunk (its first sample is the start of the recording).
     pub first: bool,
     /// The new samples (those of the previous chunk's end left out), rows of
@@ -47,24 +47,24 @@ pub struct Chunk<'a> {
 
 impl Chunk<'_> {
     /// The new samples, row by row ([`SampleRows`]' layout).
-    pub fn samples(&self) -> std::slice::ChunksExact<'_, f64> {
+    pub(crate) fn samples(&self) -> std::slice::ChunksExact<'_, f64> {
         self.rows.chunks_exact(self.width.max(1))
     }
 
     /// The switchings of the chunk.
-    pub fn events(&self) -> &[SwitchEvent] {
+    pub(crate) fn events(&self) -> &[SwitchEvent] {
         &self.trajectory.events
     }
 
     /// The energy balances of the chunk's complete periods.
-    pub fn energy(&self) -> &[EnergyBalance] {
+    pub(crate) fn energy(&self) -> &[EnergyBalance] {
         &self.trajectory.energy
     }
 }
 
 /// The totals of a chunked run.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct ChunkedSummary {
+pub(crate) struct ChunkedSummary {
     /// Switchings in all.
     pub switchings: usize,
     /// Stroboscopic section points in all.
@@ -107,7 +107,7 @@ impl ChunkedSummary {
 ///
 /// # Errors
 /// The integrator's [`SimError`], or the first error `each` returns.
-pub fn record_chunked<E: From<SimError>>(
+pub(crate) fn record_chunked<E: From<SimError>>(
     integ: &mut dyn Integrator,
     spec: &ChunkedSpec,
     mut each: impl FnMut(&Chunk<'_>) -> Result<(), E>,

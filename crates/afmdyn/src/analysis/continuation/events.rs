@@ -16,7 +16,7 @@ pub(super) fn chord_passes(a: &DVector<f64>, b: &DVector<f64>, point: &DVector<f
 }
 
 /// Largest change of a Floquet multiplier allowed in one continuation step.
-pub const MAX_MULTIPLIER_STEP: f64 = 0.25;
+pub(crate) const MAX_MULTIPLIER_STEP: f64 = 0.25;
 
 /// How far the multipliers moved: the largest distance from a multiplier of `b` to the nearest
 /// of `a` (and vice versa).

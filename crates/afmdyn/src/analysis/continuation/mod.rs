@@ -31,7 +31,7 @@ pub use switching::{continue_with_switching, period_doubling_starts, switch_at_p
 
 mod events;
 mod solver;
-pub use events::MAX_MULTIPLIER_STEP;
+pub(crate) use events::MAX_MULTIPLIER_STEP;
 use events::{changed, chord_passes, locate, multiplier_shift, point, tests};
 use solver::Solver;
 
@@ -133,14 +133,9 @@ pub enum BranchEnd {
 }
 
 impl BranchEnd {
-    /// Whether the branch covers what was asked (range left, closed or merged).
-    pub fn complete(&self) -> bool {
-        self.cause().is_none()
-    }
-
     /// Why an early end came, as a clause ("its work budget of adaptive steps", …); `None` for
     /// a complete branch.
-    pub fn cause(&self) -> Option<&'static str> {
+    pub(crate) fn cause(&self) -> Option<&'static str> {
         match self {
             BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => None,
             BranchEnd::StepFloor { .. } => Some(
@@ -153,7 +148,7 @@ impl BranchEnd {
     }
 
     /// A one-line warning for a branch that ended early, naming the parameter `param` at which
-    /// it stopped, the [`BranchEnd::cause`] and what to change; `None` for a complete branch.
+    /// it stopped, the `BranchEnd::cause` and what to change; `None` for a complete branch.
     pub fn warning(&self, param: SweepParam, period: usize) -> Option<String> {
         let cause = self.cause()?;
         let p = param.name();

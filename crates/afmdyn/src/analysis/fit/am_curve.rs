@@ -14,11 +14,11 @@
 //!   force, −HR/(6d²)), so ∂α4/∂R = α4/(2R), ∂H̃/∂R = H̃/R;
 //! * `sample.damping` c (N s/m), the Hertz law's damper (F_c = α4 δ^{3/2} + α6 δ̇,
 //!   [`crate::contact::HertzLaw`]): α6 = c g₀/(t_s F_s)
-//!   ([`crate::contact::SampleSi::damper_alpha6`]), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
+//!   (`crate::contact::SampleSi::damper_alpha6`), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
 //!   a contact-area law);
 //! * `sample.viscosity` η (Pa s), DMT's Kelvin–Voigt term α6 √δ δ̇ (JKR's α6 q² δ̇):
 //!   α6 = η √(R g₀) g₀/(t_s F_s)
-//!   ([`AmProbe::viscosity_unit`]), so ∂α6/∂η = α6/η and R's chain gains ∂α6/∂R = α6/(2R);
+//!   (`AmProbe::viscosity_unit`), so ∂α6/∂η = α6/η and R's chain gains ∂α6/∂R = α6/(2R);
 //! * `cantilever.quality_factor` Q₁ and `drive.free_amplitude` A₀ (m): through the lever's
 //!   damping α3 ∝ 1/Q₁ and the drive α2, which holds the free amplitude A₀ the instrument set
 //!   (`lever_and_drive`; the orbit's columns [`OrbitParam::LeverDamping`] and
@@ -57,7 +57,7 @@ pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `sample.hamaker` (J).
 pub(crate) const HAMAKER: &str = "sample.hamaker";
 /// `tip.radius` (m).
-pub const RADIUS: &str = "tip.radius";
+pub(crate) const RADIUS: &str = "tip.radius";
 /// `sample.damping` (N s/m), the Hertz law's damper.
 pub(crate) const DAMPING: &str = "sample.damping";
 /// `sample.viscosity` (Pa s), the Kelvin–Voigt η of DMT and JKR.
@@ -72,7 +72,7 @@ pub(crate) const ADHESION_ENERGY: &str = "sample.adhesion_energy";
 /// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
 /// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
 /// stepped sweep's, at its own tolerance).
-pub const SENSITIVITY_TOLERANCE: f64 = 1e-9;
+pub(crate) const SENSITIVITY_TOLERANCE: f64 = 1e-9;
 
 /// A parameter of the dynamic fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -194,12 +194,12 @@ impl AmProbe {
     /// α6 per Pa s of DMT's (and JKR's) Kelvin–Voigt term at the tip radius `radius` (m):
     /// √(R g₀) g₀/(t_s F_s) ([`crate::contact::SampleSi::kelvin_voigt_alpha6`]: the damper
     /// η a δ̇ with the contact radius a = √(Rδ)).
-    pub fn viscosity_unit(&self, radius: f64) -> f64 {
+    pub(crate) fn viscosity_unit(&self, radius: f64) -> f64 {
         self.damping_unit * (radius * self.length_m).sqrt()
     }
 
     /// The probe's viscosity η (Pa s) of DMT's or JKR's Kelvin–Voigt term, α6 over
-    /// [`AmProbe::viscosity_unit`]; 0 under another law.
+    /// `AmProbe::viscosity_unit`; 0 under another law.
     pub fn viscosity(&self) -> f64 {
         match self.params.contact_law {
             ContactLaw::Dmt { .. } | ContactLaw::Jkr { .. } if self.radius > 0.0 => {
@@ -211,7 +211,7 @@ impl AmProbe {
 
     /// The probe's work of adhesion W (J/m²) under JKR, from its groups: P̃ = πWR/F_s with
     /// the force scale of its Hertz group, F_s = (4/3)E*√R g₀^{3/2}/α4
-    /// ([`crate::contact::SampleSi::hertz_alpha4`]), so W = P̃ (4/3) E* g₀^{3/2}/(π α4 √R)
+    /// (`crate::contact::SampleSi::hertz_alpha4`), so W = P̃ (4/3) E* g₀^{3/2}/(π α4 √R)
     /// (the probe's E*, R, g₀). 0 under another law (or α4 = 0).
     pub fn adhesion_energy(&self) -> f64 {
         let ContactLaw::Jkr { adhesion } = self.params.contact_law else {
@@ -246,7 +246,7 @@ pub struct AmCurveModel {
     /// The stepped sweep's settings (its values are overwritten by the rows').
     pub spec: SteppedSpec,
     /// The adaptive integrator's tolerance of the sensitivities (default
-    /// [`SENSITIVITY_TOLERANCE`]).
+    /// `SENSITIVITY_TOLERANCE`).
     pub tolerance: f64,
     /// The last evaluation's warnings.
     warnings: Mutex<Vec<String>>,
@@ -283,7 +283,7 @@ impl AmCurveModel {
 
 /// The gaps α5 of the rows at the piezo positions `z` (m), shifted by `z_offset` (m), under the
 /// parameters `q` of `probe` (module docs: α5 from the rest distance (z + z_offset)/g₀).
-pub fn gaps(probe: &AmProbe, q: &Params, z: &[f64], z_offset: f64) -> Vec<f64> {
+pub(crate) fn gaps(probe: &AmProbe, q: &Params, z: &[f64], z_offset: f64) -> Vec<f64> {
     let g0 = probe.length_m;
     z.iter()
         .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))

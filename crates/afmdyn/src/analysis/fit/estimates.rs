@@ -16,20 +16,20 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use nalgebra::DMatrix;
 
-pub use super::profile::Z_95;
+pub(crate) use super::profile::Z_95;
 
 /// Above this |correlation| two parameters are called not separately identifiable.
 pub(crate) const CORRELATION_WARNING: f64 = 0.99;
 
 /// Profiles are computed for at most this many fitted parameters (Wald intervals beyond):
 /// [`profiled`] chooses them.
-pub const MAX_PROFILED: usize = 4;
+pub(crate) const MAX_PROFILED: usize = 4;
 
 /// Which of the fitted parameters `names` get profiles: all of them up to [`MAX_PROFILED`];
 /// beyond, the sample's, tip's and lever's (a probe key, `section.key`) first and then the
 /// curve's own (contact point, baseline, z_offset), in order, [`MAX_PROFILED`] in all — the
 /// properties sought before the nuisance parameters.
-pub fn profiled<S: AsRef<str>>(names: &[S]) -> Vec<bool> {
+pub(crate) fn profiled<S: AsRef<str>>(names: &[S]) -> Vec<bool> {
     let mut on = vec![false; names.len()];
     let order = (0..names.len())
         .filter(|&k| names[k].as_ref().contains('.'))
@@ -55,7 +55,7 @@ pub struct Estimate {
     pub standard_error: f64,
     /// The Wald interval p̂ ± 1.96 SE.
     pub wald: [f64; 2],
-    /// The 95 % interval: the profile's where computed ([`MAX_PROFILED`]), else the Wald one.
+    /// The 95 % interval: the profile's where computed (`MAX_PROFILED`), else the Wald one.
     pub interval: [f64; 2],
     /// The profile, when computed.
     pub profile: Option<Profile>,
@@ -64,7 +64,7 @@ pub struct Estimate {
 /// Standard deviations of χ²/dof above 1 beyond which a fit with σ given warns that the model
 /// does not describe the data (χ² of m − n degrees of freedom has mean m − n and variance
 /// 2(m − n); at 4 of them a fit that does describe its data warns about once in 30 000).
-pub const CHI2_SIGMAS: f64 = 4.0;
+pub(crate) const CHI2_SIGMAS: f64 = 4.0;
 
 /// A fit's outcome: estimates, correlation, χ²/dof, the model beside the data, warnings.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,7 +97,7 @@ pub struct FitOutcome {
 
 /// Fit `model` to `obs` over the parameters `params` whose `fixed` entry is `None` (the others
 /// held at it), from their start values; with the profile-likelihood intervals of up to
-/// [`MAX_PROFILED`] of them when `profiles` (walked on the grid, [`ProfileWalk::Grid`]; else
+/// `MAX_PROFILED` of them when `profiles` (walked on the grid, [`ProfileWalk::Grid`]; else
 /// the Wald intervals, ±1.96 standard errors).
 ///
 /// # Panics

@@ -60,8 +60,8 @@ pub struct FmCurveModel {
 
 impl FmCurveModel {
     /// A model of the rows `z` (m) under `probe` (whose scales give `hz_per_omega`), with
-    /// parameters `params`; setpoint A₀, the loop to [`DEFAULT_LOOP_TOLERANCE`], the
-    /// sensitivities to [`SENSITIVITY_TOLERANCE`].
+    /// parameters `params`; setpoint A₀, the loop to `DEFAULT_LOOP_TOLERANCE`, the
+    /// sensitivities to `SENSITIVITY_TOLERANCE`.
     pub fn new(probe: AmProbe, z: Vec<f64>, params: Vec<AmParam>, hz_per_omega: f64) -> Self {
         FmCurveModel {
             probe,

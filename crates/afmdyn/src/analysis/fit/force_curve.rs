@@ -19,7 +19,7 @@
 //!
 //! # Model
 //! F(x) = baseline + F_c(δ), δ = contact_point − x (the indentation), F_c the law's force of
-//! the registry ([`crate::contact::Law::force`]) evaluated in SI: its Hertz group
+//! the registry (`crate::contact::Law::force`) evaluated in SI: its Hertz group
 //! k_H = (4/3)E*√R (Hertz 1882; Sneddon, *Int. J. Eng. Sci.* 3 (1965) 47, eq. 6.9: the
 //! paraboloid F = (4/3) E/(1 − ν²) √R δ^{3/2} of a rigid tip), 1/E* = (1 − ν_t²)/E_t +
 //! (1 − ν_s²)/E_s (Johnson, *Contact Mechanics*, 1985, eq. 4.22); DMT's van der Waals group
@@ -41,7 +41,7 @@ use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law, LawKin
 /// solid (Zener, with surface memory, in time: its model is
 /// [`super::sls_curve::SlsCurveModel`], not [`ForceCurveModel`]); `None` for a law the fit does
 /// not take.
-pub fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
+pub(crate) fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
     match law {
         LawKind::Hertz => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE]),
         LawKind::Dmt => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER]),
@@ -60,7 +60,7 @@ pub fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
 /// `sample.youngs_modulus` (Pa).
 pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `tip.radius` (m).
-pub const RADIUS: &str = "tip.radius";
+pub(crate) const RADIUS: &str = "tip.radius";
 /// `contact_point` (m): the tip position where δ = 0, after `correct_tip_offset`.
 pub(crate) const CONTACT_POINT: &str = "contact_point";
 /// `baseline` (N): the force far from the sample, after `correct_force_offset`.
@@ -176,10 +176,10 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
 }
 
 /// The force-curve model at the rows' tip positions (module docs). Parameters in
-/// [`parameter_names`]' order.
+/// `parameter_names`' order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceCurveModel {
-    /// The law (one [`parameter_names`] takes).
+    /// The law (one `parameter_names` takes).
     pub law: LawKind,
     /// The tip positions x (m) of the fitted rows.
     pub x: Vec<f64>,

@@ -8,10 +8,10 @@
 //! (1975) 343; as lmfit does): p = lo + (hi − lo)(sin u + 1)/2 between two bounds,
 //! p = lo + s(√(u² + 1) − 1) above a lower one (below an upper one alike), p = s u without;
 //! s is the parameter's scale, so every u is of order one. The model's Jacobian ∂f/∂p is
-//! chained with dp/du; the covariance is formed in p ([`super::estimates`]).
+//! chained with dp/du; the covariance is formed in p (`super::estimates`).
 //!
 //! Every evaluation is counted in the run's [`Progress`] and checks its cancel flag first
-//! ([`minimize_cancellable`]): a cancelled run stops the minimiser at its next evaluation (the
+//! (`minimize_cancellable`): a cancelled run stops the minimiser at its next evaluation (the
 //! model's residuals refused, the crate's `User` termination) and returns
 //! [`SimError::Cancelled`]; a model whose evaluation is long also stops inside it
 //! ([`CurveModel::evaluate_cancellable`]).
@@ -25,7 +25,7 @@ use std::sync::atomic::AtomicBool;
 /// The minimiser's relative tolerances (MINPACK's ftol, xtol, gtol): χ² to 1e-10 relative is
 /// Δχ² to 1e-6 at 10⁴ points, far inside the profiles' 3.84, and the estimates to ~1e-10 of
 /// their standard errors' scale.
-pub const TOLERANCE: f64 = 1e-10;
+pub(crate) const TOLERANCE: f64 = 1e-10;
 
 /// The minimiser's patience: it stops after `PATIENCE × (n + 1)` evaluations of the residuals
 /// (n free parameters; MINPACK's `maxfev`, the crate's `with_patience`).
@@ -147,7 +147,7 @@ pub struct Observations<'a> {
 
 impl Observations<'_> {
     /// The weight 1/σᵢ of point i.
-    pub fn weight(&self, i: usize) -> f64 {
+    pub(crate) fn weight(&self, i: usize) -> f64 {
         self.sigma.map_or(1.0, |s| 1.0 / s[i])
     }
 }
@@ -246,13 +246,6 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 }
 
-/// χ²(p) = Σ((yᵢ − fᵢ(p))/σᵢ)² of `model` at `p`.
-pub fn chi2(model: &dyn CurveModel, obs: &Observations, p: &[f64]) -> f64 {
-    let mut f = vec![0.0; model.points()];
-    model.evaluate(p, &mut f, None);
-    sum_squares(obs, &f)
-}
-
 /// [`chi2`] as one evaluation of a run ([`evaluate_in`]).
 ///
 /// # Errors
@@ -307,7 +300,7 @@ pub fn minimize(
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled before the minimum is found.
-pub fn minimize_cancellable(
+pub(crate) fn minimize_cancellable(
     model: &dyn CurveModel,
     obs: &Observations,
     params: &[Parameter],

@@ -1,7 +1,7 @@
 //! Profile-likelihood intervals: the parameter held at values walked outward from its
 //! estimate, the others refitted at each (each refit started from the neighbouring point's
 //! values), and the interval where Δχ² = χ²_profile − χ²_min stays at or below
-//! [`DELTA_CHI2_95`] (Venzon & Moolgavkar, *J. R. Stat. Soc. C* 37 (1988) 87; Raue et al.,
+//! `DELTA_CHI2_95` (Venzon & Moolgavkar, *J. R. Stat. Soc. C* 37 (1988) 87; Raue et al.,
 //! *Bioinformatics* 25 (2009) 1923, which also names a profile that never rises a
 //! *practically non-identifiable* parameter). Without σ the χ² are scaled by the noise
 //! variance estimated at the minimum, s² = χ²_min/(m − n).
@@ -20,13 +20,13 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 
 /// The standard normal's 97.5 % quantile: the Wald interval is p̂ ± 1.96 SE.
-pub const Z_95: f64 = 1.959_963_984_540_054;
+pub(crate) const Z_95: f64 = 1.959_963_984_540_054;
 
 /// The 95 % quantile of χ² with one degree of freedom, 3.841 (the profile's threshold).
-pub const DELTA_CHI2_95: f64 = 3.841_458_820_694_124;
+pub(crate) const DELTA_CHI2_95: f64 = 3.841_458_820_694_124;
 
 /// The most grid points walked on each side before the profile is called flat (the grid walk).
-pub const MAX_PROFILE_STEPS: usize = 30;
+pub(crate) const MAX_PROFILE_STEPS: usize = 30;
 
 /// Bisections refining a crossing of [`DELTA_CHI2_95`] between two grid points.
 const BISECTIONS: usize = 5;
@@ -36,7 +36,7 @@ const BISECTIONS: usize = 5;
 /// profile is called flat.
 pub const MAX_SECANT_STEPS: usize = 6;
 
-/// The secant walk ends at a refit whose Δχ² is within this of [`DELTA_CHI2_95`]: 3.841 ± 0.05,
+/// The secant walk ends at a refit whose Δχ² is within this of `DELTA_CHI2_95`: 3.841 ± 0.05,
 /// i.e. r = √Δχ² within 1.96 ± 0.013, the end within 0.65 % of the interval's half-width for a
 /// parabolic profile; the coverage of χ²₁ at 3.791 … 3.891 is 94.84 … 95.14 %.
 pub const SECANT_TOLERANCE: f64 = 0.05;
@@ -57,7 +57,7 @@ pub const REFIT_PATIENCE: usize = 50;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProfileWalk {
     /// Steps of half a standard error, growing by half after 4 SE, up to
-    /// [`MAX_PROFILE_STEPS`] a side; a crossing bisected 5 times and interpolated linearly in
+    /// `MAX_PROFILE_STEPS` a side; a crossing bisected 5 times and interpolated linearly in
     /// its last bracket (every grid point a refit: for a model whose evaluations are cheap).
     Grid,
     /// The secant walk on √Δχ²: the first refit at one standard error, then the secant through
@@ -120,7 +120,7 @@ pub struct Profile {
 /// A least-squares fit at its minimum, as a profile walks about it: the model, the
 /// observations and the parameters, the minimum `best`, the parameters `fixed` in the fit, and
 /// `s2`, which scales χ² (the noise variance, 1 with σ given).
-pub struct Fitted<'a> {
+pub(crate) struct Fitted<'a> {
     /// The model fitted.
     pub model: &'a dyn CurveModel,
     /// The observations.
@@ -143,7 +143,7 @@ pub struct Fitted<'a> {
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled.
-pub fn profile(
+pub(crate) fn profile(
     fit: &Fitted,
     j: usize,
     step: f64,

@@ -8,7 +8,7 @@
 //! W(1,τ) = φᵀa against the drive, q_s' = W sin θ, q_c' = W cos θ (θ = Ωτ + ψ, ψ the drive's
 //! phase, [`crate::params::Params::drive_phase`]), and by the parameters p with p' = 0. The
 //! extended system's Jacobian has the parameter columns ∂f/∂p = (0, M⁻¹φ ∂F_c/∂p), with ∂F_c/∂p
-//! in closed form from the law (F_c the law's force at δ = −V_T, δ̇ = −V̇_T, [`d_force`]):
+//! in closed form from the law (F_c the law's force at δ = −V_T, δ̇ = −V̇_T, `d_force`):
 //! * α5 enters through the gap, V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8), so ∂F_c/∂α5 =
 //!   −∂F_c/∂δ;
 //! * both laws are linear in α4 (Hertz 1882; Johnson, *Contact Mechanics*, 1985, eq. 4.23: the
@@ -31,7 +31,7 @@
 //! # The drive
 //! The FM loop's unknowns ([`super::fm_curve`]) are the drive's α2 and Ω:
 //! * α2 enters the forcing b(τ) = b₀ + b_s sin Ωτ + b_c cos Ωτ linearly
-//!   ([`CantileverModel::forcing_derivative`]) and, on the base-driven beam, the tip force
+//!   (`CantileverModel::forcing_derivative`) and, on the base-driven beam, the tip force
 //!   through V_T = W + α2 sin Ωτ + α5 and V̇_T = W' + α2 Ω cos Ωτ (eq. 8), so its column is
 //!   ∂b/∂α2 + M⁻¹φ (−∂F_c/∂δ sin Ωτ − ∂F_c/∂δ̇ Ω cos Ωτ) there (the point mass's V_T has no
 //!   drive term); the guard σV_T moves by σ sin Ωτ.
@@ -49,7 +49,7 @@
 //! α3 sets the lever's damping matrix C^I = α3 diag(s) (eq. 12; s the damping profile, 1 in
 //! the paper) and, on the base-driven beam, the forcing's base-velocity term −α2 α3 s_i ∫φ_i
 //! cos Ωτ (eq. 14). The state's rate (ȧ, M⁻¹(F − C ȧ − K a + φ F_c)) is affine in α3, so its
-//! column is (0, M⁻¹(∂F/∂α3(τ) − diag(s) ȧ)) ([`CantileverModel::damping_derivative`]); the
+//! column is (0, M⁻¹(∂F/∂α3(τ) − diag(s) ȧ)) (`CantileverModel::damping_derivative`); the
 //! law's force, the guard σV_T and the saltation's jump do not move with α3.
 //!
 //! The adaptive integrator's variational equations of the extended system
@@ -81,7 +81,7 @@
 //! measures: the smallest singular value of I − M against [`fold_threshold`] ([`FOLD_TOL`], or
 //! less for a high-Q lever whose free multipliers lie near +1), and the grazing distance
 //! of the flow ([`crate::maps::flow::FlowMap::grazing_distance`]) against
-//! [`crate::analysis::shooting::GRAZING_TOL`].
+//! `crate::analysis::shooting::GRAZING_TOL`.
 //!
 //! Units are the model's (lengths in g₀, τ, forces F̃). Only period-1 orbits; only the laws
 //! `hertz` (with or without its damper α6 δ̇), `dmt` (with or without its Kelvin–Voigt term
@@ -92,7 +92,7 @@
 //! Kelvin–Voigt group α6 (the damper α6 q² δ̇):
 //! its force at fixed δ moves through the root q(δ) of the contact radius, its contact guard
 //! |δ_b| − V_T moves with α4 and P̃, and its force jumps where the contact forms and breaks, so
-//! the saltation is not the identity there ([`super::sensitivity_jkr`] for the derivatives).
+//! the saltation is not the identity there (`super::sensitivity_jkr` for the derivatives).
 
 use crate::analysis::shooting::{shoot, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
@@ -248,7 +248,7 @@ fn harmonic(q: (f64, f64), dq: &DMatrix<f64>, period: f64) -> Harmonic {
 /// Hertz, DMT and JKR, for H̃ of Hertz and JKR, and for the parameters that do not enter the
 /// law: the drive's α2 and Ω (which move δ and δ̇ with the drive's phase), the lever's α3 and
 /// the component force F̃₁ (the extended system forms their columns).
-pub fn d_force(
+pub(crate) fn d_force(
     law: &ContactLaw,
     stiffness: f64,
     damping: f64,

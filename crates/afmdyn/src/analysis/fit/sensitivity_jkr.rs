@@ -43,7 +43,7 @@ use crate::system::Region;
 /// group α6 = `damping`) at indentation δ = `delta` and rate δ̇ = `rate`, in or out of contact
 /// (module docs), for p = α5, α4, P̃ and α6; `None` for the other parameters (H̃ is not JKR's;
 /// the drive's columns are formed by the extended system from the law's partials).
-pub fn d_force(
+pub(crate) fn d_force(
     alpha4: f64,
     adhesion: f64,
     damping: f64,

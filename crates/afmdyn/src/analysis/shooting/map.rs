@@ -459,7 +459,7 @@ pub fn map_section_points(
 }
 
 /// The period-n orbit through `z` (converged to `opts.tol`) reduced to its minimal period:
-/// the orbit shot again at the [`proper_period`] of its section, which must converge there
+/// the orbit shot again at the `proper_period` of its section, which must converge there
 /// (else n stands), finished with `opts`' grazing watch. `Ok(None)` when n is minimal (costs
 /// n − 1 plain flows of one period).
 ///

@@ -8,7 +8,7 @@
 //! [`AverageOptions::window_periods`] primary drive periods 2π/Ω, each component demodulated
 //! over a Hann² window ([`observe_tapered`]), until two successive windows' phasors
 //! A_i e^{iφ_i} differ by at most [`AverageOptions::tol`] of each free amplitude A₀ᵢ (or the
-//! point's transient cap, [`transient_cap`], is spent: the point is then reported unsettled).
+//! point's transient cap, `transient_cap`, is spent: the point is then reported unsettled).
 //! The point's observables are then measured over one such window of
 //! [`AverageOptions::windows`] such windows.
 //!
@@ -33,25 +33,25 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
 /// Fewest primary drive periods in a settling window ([`AverageOptions::for_model`]).
-pub const MIN_WINDOW_PERIODS: usize = 16;
+pub(crate) const MIN_WINDOW_PERIODS: usize = 16;
 /// Frequency bins 2π/L between a drive frequency and the nearest harmonic of another in a
 /// settling window of length L ([`AverageOptions::for_model`]): the Hann² window's main lobe
 /// spans ±3 bins, and 8 bins away its transform is 3e-5 of its peak.
-pub const RESOLUTION: f64 = 8.0;
+pub(crate) const RESOLUTION: f64 = 8.0;
 /// Highest harmonic of each drive frequency kept [`RESOLUTION`] bins from the others.
-pub const RESOLVED_HARMONIC: u32 = 10;
+pub(crate) const RESOLVED_HARMONIC: u32 = 10;
 /// Largest denominator q of the fractions p/q whose combination tones [`slowest_beat`] follows.
-pub const BEAT_DENOMINATOR: u32 = 32;
+pub(crate) const BEAT_DENOMINATOR: u32 = 32;
 /// Beats of [`slowest_beat`] per settling window: 3 or more put the beat's sidebands on the
 /// zeros of the Hann² window's transform (it vanishes at every whole bin from the third on).
 pub(crate) const BEATS_PER_WINDOW: f64 = 4.0;
 /// Longest settling window the defaults choose ([`AverageOptions::for_model`]): a slower beat
 /// leaves the point unsettled, and the warning says why.
-pub const MAX_DEFAULT_WINDOW: usize = 4096;
+pub(crate) const MAX_DEFAULT_WINDOW: usize = 4096;
 
 /// The slowest beat of a multifrequency drive's combination tones: for each component's ratio
-/// r = f_i/f₁ its best rational approximation p/q with q ≤ [`BEAT_DENOMINATOR`]
-/// ([`crate::params::convergent_within`]), whose tone q f_i − p f₁ = q f₁ (r − p/q) a tapping
+/// r = f_i/f₁ its best rational approximation p/q with q ≤ `BEAT_DENOMINATOR`
+/// (`crate::params::convergent_within`), whose tone q f_i − p f₁ = q f₁ (r − p/q) a tapping
 /// tip's nonlinearity makes: the motion's averages over windows shorter than its period
 /// 1/(q |r − p/q|) primary periods follow the beat instead of settling (at f₂ = 1761/281 f₁,
 /// 94/15: the beat is the common period, 281 periods). The slowest over the components as
@@ -81,15 +81,15 @@ pub struct AverageOptions {
 
 impl AverageOptions {
     /// The defaults for `model`'s drive, from its frequencies and its decay time: settling
-    /// windows of at least [`MIN_WINDOW_PERIODS`] periods, long enough that every drive
-    /// frequency (Ω and p/q Ω of every component) lies [`RESOLUTION`] frequency bins from the
-    /// harmonics up to the [`RESOLVED_HARMONIC`]th of the others — where a tapping tip's
+    /// windows of at least `MIN_WINDOW_PERIODS` periods, long enough that every drive
+    /// frequency (Ω and p/q Ω of every component) lies `RESOLUTION` frequency bins from the
+    /// harmonics up to the `RESOLVED_HARMONIC`th of the others — where a tapping tip's
     /// strongest combination tones lie, so that they do not beat in the demodulation (at
     /// f₂ = 6.27 f₁ the 6th harmonic of f₁ is 0.27 f₁ from f₂: 30 periods) — and at least
     /// half the slowest free mode's decay time 1/λ, so that the transient changes between
     /// windows by a sizeable factor (e^{−1/2}; at Q = 400, 64 periods), and at least four
     /// periods of the slowest beat of the combination tones ([`slowest_beat`]), up to
-    /// [`MAX_DEFAULT_WINDOW`] periods in all; four of them measured;
+    /// `MAX_DEFAULT_WINDOW` periods in all; four of them measured;
     /// tolerance 1e-5 (in contact the windows of a 40 N/m lever tapping polystyrene at
     /// f₂ = 6.27 f₁ still differ by 1e-6 of A₀ after 20 000 periods: combination tones of high
     /// order).

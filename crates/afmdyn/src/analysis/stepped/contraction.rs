@@ -5,7 +5,7 @@
 //!
 //! **The rule.** Over each run of returns z_0, z_1, … (one per drive period) the spread of lag
 //! m (1 ≤ m ≤ `max_period`) is s_m = max_k ‖z_k − z_{k−m}‖ / (1 + ‖z_k‖), the quantity the
-//! period test compares with its tolerance `tol` ([`crate::analysis::period::close`]). A
+//! period test compares with its tolerance `tol` (`crate::analysis::period::close`). A
 //! motion going to a period-m orbit has returns whose lag-m differences contract
 //! geometrically, by a ratio r = s_m(now)/s_m(before) over the D drive periods between two
 //! runs' starts; at that ratio they fall below `tol` after

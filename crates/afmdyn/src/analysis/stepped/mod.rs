@@ -11,13 +11,13 @@
 //! variational equations step by step, Broyden's method from the previous orbits' monodromy
 //! matrix, [`super::shooting::ShootingStrategy::Broyden`]): a stable orbit near the previous
 //! one is its continuation, the state the motion settles on; a step the orbit moves too far in
-//! is halved (quasi-static sub-steps, [`SUBSTEP_DEPTH`]) as long as halving brings the orbits
+//! is halved (quasi-static sub-steps, `SUBSTEP_DEPTH`) as long as halving brings the orbits
 //! closer. When the orbit cannot be followed — Newton fails or lands on an unstable orbit, or
 //! the distance does not shrink with the step: the attractor vanished at a fold, a jump — the
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
 //! ([`settle`]); a motion that never settles on a period-n orbit is watched by the returns'
-//! period test and by its windowed time average, within the point's [`transient_cap`]: a
+//! period test and by its windowed time average, within the point's `transient_cap`: a
 //! period found is polished by Newton, and a motion whose windows agree first is reported
 //! `averaged` (no short period found, [`Reached::Averaged`], with a warning).
 //!
@@ -38,7 +38,7 @@ use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
 use crate::analysis::progress::Progress;
-pub use crate::analysis::settle::Found;
+pub(crate) use crate::analysis::settle::Found;
 use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
 use crate::analysis::shooting::{
     broyden_pays, shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,
@@ -74,7 +74,7 @@ pub const MAX_CURVE_POINTS: usize = 100_000;
 /// library's 1e-12 makes a map ~3× cheaper, and changes A and φ of the point-mass DMT
 /// approach curve (Q = 400) by < 5e-8 (relative to A₀, and rad) — below the 1e-6 agreement
 /// with an independent integrator that the tests require.
-pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+pub(crate) const DEFAULT_TOLERANCE: f64 = 1e-10;
 
 /// How the grid of a stepped sweep is spaced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,7 +152,7 @@ pub struct SteppedSpec {
     /// Its values in the order of the first sweep (the second runs back), at least 2.
     pub values: Vec<f64>,
     /// Integrator of every orbit and observable (default: auto with tolerance
-    /// [`DEFAULT_TOLERANCE`]).
+    /// `DEFAULT_TOLERANCE`).
     pub integrator: IntegratorOptions,
     /// Newton shooting from the previous orbit (default: tolerance 1e-10, at most 6 iterations:
     /// from the secant prediction Newton converges in ~3; one that has not converged by 6 is
@@ -161,7 +161,7 @@ pub struct SteppedSpec {
     pub newton: ShootingOptions,
     /// Classification of a motion that does not settle on an orbit; `max_periods` is the most
     /// drive periods of transient a point may take, [`settle`] and classification together
-    /// (less where the damping is strong: [`transient_cap`]).
+    /// (less where the damping is strong: `transient_cap`).
     pub steady: SteadyOptions,
     /// Drive periods between Newton attempts while settling.
     pub chunk_periods: usize,
@@ -191,7 +191,7 @@ pub struct SteppedSpec {
 
 impl SteppedSpec {
     /// Defaults for a sweep of `param` through `values`.
-    pub fn new(base: Params, param: SweepParam, values: Vec<f64>) -> Self {
+    pub(crate) fn new(base: Params, param: SweepParam, values: Vec<f64>) -> Self {
         SteppedSpec {
             base,
             param,
@@ -418,10 +418,10 @@ fn relative_gap(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
 }
 
 /// Fewest drive periods of transient a point of a stepped sweep may take ([`transient_cap`]).
-pub const POINT_MIN_PERIODS: usize = 5_000;
+pub(crate) const POINT_MIN_PERIODS: usize = 5_000;
 
 /// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
-pub const POINT_DECAY_TIMES: f64 = 9.0;
+pub(crate) const POINT_DECAY_TIMES: f64 = 9.0;
 
 /// The drive periods of transient a point of a stepped sweep may take, [`settle`]'s Newton
 /// attempts, period test and time average together: [`POINT_DECAY_TIMES`] times the periods
@@ -435,7 +435,7 @@ pub const POINT_DECAY_TIMES: f64 = 9.0;
 /// periodic window in a chaotic band that is a matter of the start state — the default
 /// resonance curve's classification there changes with round-off-level changes of its start
 /// — which no cap removes, while each nonperiodic point costs the whole cap.
-pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize {
+pub(crate) fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize {
     let cap = spec.steady.cap(system);
     let Some(decay) = decay_periods(system, spec.steady.tol) else {
         return cap;
@@ -446,7 +446,7 @@ pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize 
 
 /// Halvings of a grid step tried by the sweep's orbit continuation (quasi-static sub-steps, see
 /// the module docs) before it falls back on the transient (at most 2^depth sub-steps).
-pub const SUBSTEP_DEPTH: usize = 8;
+pub(crate) const SUBSTEP_DEPTH: usize = 8;
 
 /// The points of both sweeps after the `stored` ones (a run that was cut short handed them to
 /// `sink`, in order: the first sweep's through `spec.values`, then the sweep back's; none for
@@ -457,7 +457,7 @@ pub const SUBSTEP_DEPTH: usize = 8;
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set; [`SimError`] from the model or the
 /// integrator.
-pub fn sweep_points(
+pub(crate) fn sweep_points(
     spec: &SteppedSpec,
     stored: &[CurvePoint],
     cancel: &AtomicBool,
@@ -496,7 +496,7 @@ pub fn sweep_points(
 ///
 /// # Errors
 /// [`SimError::OutOfRange`], [`SimError::NotFinite`], [`SimError::Params`].
-pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
+pub(crate) fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
     if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
         return Err(SimError::out_of_range(
             "points",
@@ -568,7 +568,7 @@ pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
 /// # Errors
 /// [`SimError::Cancelled`] once `progress` is cancelled; [`SimError`] from the traces' model
 /// or integrator. A branch that cannot be continued is a warning.
-pub fn finish_curve(
+pub(crate) fn finish_curve(
     spec: &SteppedSpec,
     first: Vec<CurvePoint>,
     second: Vec<CurvePoint>,

@@ -24,7 +24,7 @@ pub const AVERAGE_TOL: f64 = 1e-3;
 pub const AVERAGE_AGREEMENTS: usize = 2;
 
 /// Fewest drive periods in a window of [`settle`]'s time average; at most
-/// [`super::average::MAX_DEFAULT_WINDOW`].
+/// `super::average::MAX_DEFAULT_WINDOW`.
 pub const AVERAGE_MIN_WINDOW: usize = 16;
 
 /// What [`settle`] reached.
@@ -39,7 +39,7 @@ pub struct Settled {
     pub averaged: Option<Observables>,
     /// The motion was settled by its time average only at the end of the free decay's wait,
     /// which runs of returns whose contraction could not be measured kept where its windows
-    /// had agreed earlier ([`super::contraction`]): right, only slower.
+    /// had agreed earlier (`super::contraction`): right, only slower.
     pub free_decay_wait: bool,
 }
 
@@ -60,9 +60,9 @@ fn average_window(system: &dyn TipSampleSystem) -> usize {
 
 /// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles:
 /// Newton shooting for a period-`n` orbit from the transient every `spec.chunk_periods`
-/// periods, for at most [`NEWTON_CHUNKS`] chunks, until the trajectory is seen to go to a
-/// stable orbit ([`newton_from_transient`]); otherwise, over the periods of the point's
-/// [`transient_cap`] not yet spent, in windows (half the slowest free decay time, at least
+/// periods, for at most `NEWTON_CHUNKS` chunks, until the trajectory is seen to go to a
+/// stable orbit (`newton_from_transient`); otherwise, over the periods of the point's
+/// `transient_cap` not yet spent, in windows (half the slowest free decay time, at least
 /// [`AVERAGE_MIN_WINDOW`] periods) of the stroboscopic
 /// returns' period test (`spec.steady`: a period-m orbit, polished by Newton; each run of
 /// returns at least 4 `max_period` + 2 periods, to confirm any period) alternating with
@@ -75,7 +75,7 @@ fn average_window(system: &dyn TipSampleSystem) -> usize {
 /// measured contraction ends that wait earlier (`spec.settle_wait`, [`SettleWait`]): in
 /// [`STALLED_RUNS`] successive runs no lag m ≤ `max_period` of the returns' differences
 /// contracted fast enough to reach the period test's tolerance before the free decay's wait
-/// ends (a geometric projection from the ratio between runs, [`super::contraction`]). A
+/// ends (a geometric projection from the ratio between runs, `super::contraction`). A
 /// tapping orbit
 /// whose returns spiral in too slowly for a short period to show (JKR's neck: its period test
 /// ran to the cap of 20 000 periods) is so settled in a few hundred. A motion that neither

@@ -16,12 +16,12 @@
 //! periodic orbit of the common period, to the circle's interpolation error (period 1 in
 //! common periods, its state the orbit's at τ = 0). Where the circle is not found, lands
 //! away from the previous point (a jump), is unstable, or is not smooth (a node within
-//! [`crate::analysis::torus::NEAR_GRAZING`] of grazing: a touch appears at some phases of the
+//! `crate::analysis::torus::NEAR_GRAZING` of grazing: a touch appears at some phases of the
 //! second drive and not at others, and the interpolation converges only algebraically), the
 //! point is the exact orbit (as without circles: continued, halved, or settled by
 //! the transient), flagged with [`Fallback`]; the curve's warnings count them. Inside a stretch
 //! of such points (not smooth or not found) the circle is tried only at every
-//! [`STRETCH_RETRY`]-th point ([`Fallback::Skipped`]).
+//! `STRETCH_RETRY`-th point ([`Fallback::Skipped`]).
 
 use super::point::{orbit_point, prediction_slope};
 use super::{relative_gap, CurvePoint, Reached, SteppedSpec};
@@ -36,8 +36,8 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 /// Common periods (in primary drive periods) beyond which a two-frequency approach curve is
-/// measured on invariant circles by default ([`uses_torus`]): an exact orbit then spans more
-/// than this many periods, a circle [`CURVE_NODES`] or a few more (at 6.25 = 25/4 the orbit
+/// measured on invariant circles by default (`uses_torus`): an exact orbit then spans more
+/// than this many periods, a circle `CURVE_NODES` or a few more (at 6.25 = 25/4 the orbit
 /// spans 4 and is kept; at 94/15, 15; at 6.27 = 627/100, 100 against a circle's 37).
 pub const TORUS_PERIODS: u64 = 32;
 
@@ -45,13 +45,13 @@ pub const TORUS_PERIODS: u64 = 32;
 /// 627/100 (the convergent 10/37 of 0.27), whose points agree with the exact orbits' to 1e-7
 /// of each free amplitude on the eigenmode lever in the repulsive regime, where 26 nodes leave
 /// 2.5e-6 (`tests/torus.rs`; the N = 3 beam needs 63, asked by 38).
-pub const CURVE_NODES: usize = 30;
+pub(crate) const CURVE_NODES: usize = 30;
 
 /// The options of a curve measured on invariant circles ([`SteppedSpec::torus`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TorusOptions {
-    /// Nodes asked for, in 1..=[`MAX_NODES`]
-    /// ([`crate::maps::circle::node_count`] rounds up to a convergent's or semiconvergent's
+    /// Nodes asked for, in 1..=`MAX_NODES`
+    /// (`crate::maps::circle::node_count` rounds up to a convergent's or semiconvergent's
     /// denominator of the rotation: 30 gives 37 at 627/100).
     pub nodes: usize,
 }
@@ -83,7 +83,7 @@ impl TorusOptions {
 /// two frequencies (one further component) whose common period spans more than
 /// [`TORUS_PERIODS`] drive periods and has a periodic orbit to fall back on (not
 /// quasi-periodic, [`Params::is_quasiperiodic`]).
-pub fn uses_torus(base: &Params) -> bool {
+pub(crate) fn uses_torus(base: &Params) -> bool {
     base.components().count() == 1
         && base.common_periods() > TORUS_PERIODS
         && !base.is_quasiperiodic()
@@ -141,7 +141,7 @@ pub enum Fallback {
     Unstable,
     /// The circle found is farther than the jump tolerance from the previous point.
     Jump,
-    /// The circle was not tried: the point lies in a grazing stretch ([`STRETCH_RETRY`]).
+    /// The circle was not tried: the point lies in a grazing stretch (`STRETCH_RETRY`).
     Skipped,
 }
 
@@ -166,7 +166,7 @@ impl Fallback {
 /// some phases and not at others), and each try costs a circle's Newton on top of the orbit;
 /// past the stretch's end at most `STRETCH_RETRY − 1` points are exact orbits that a circle
 /// would have measured. At most 4: a point sees the last 3 points of its sweep.
-pub const STRETCH_RETRY: usize = 4;
+pub(crate) const STRETCH_RETRY: usize = 4;
 
 /// Whether the point after `history` skips its circle ([`STRETCH_RETRY`]).
 fn skips_circle(history: &[CurvePoint]) -> bool {

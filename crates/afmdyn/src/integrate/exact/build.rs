@@ -23,7 +23,7 @@ use std::sync::Arc;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Propagation {
     /// Modal wherever the eigenvector basis is well conditioned (condition number ≤
-    /// [`MAX_MODAL_CONDITION`](super::MAX_MODAL_CONDITION) and residual at round-off), dense
+    /// `MAX_MODAL_CONDITION` and residual at round-off), dense
     /// elsewhere (default): the faster path at every N measured, N = 1 included
     /// (`docs/performance.md`).
     #[default]
@@ -91,7 +91,7 @@ impl ExactPropagator {
     ///
     /// # Errors
     /// As [`ExactPropagator::try_new`]; [`SimError::Budget`] when the grid of one period would
-    /// exceed [`crate::params::GRID_BUDGET_BYTES`].
+    /// exceed `crate::params::GRID_BUDGET_BYTES`.
     pub fn try_with(model: &CantileverModel, opts: ExactOptions) -> Result<Self, SimError> {
         if !model.law().is_affine() {
             return Err(SimError::Unsupported {

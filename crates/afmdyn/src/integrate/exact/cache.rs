@@ -33,7 +33,7 @@ use crate::error::SimError;
 use std::sync::{Arc, Mutex};
 
 /// Entries kept per table (least recently used dropped first).
-pub const CAPACITY: usize = 8;
+pub(crate) const CAPACITY: usize = 8;
 
 /// One table: (key, value) entries, the most recently used last.
 type Table<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
@@ -57,7 +57,7 @@ impl PropagatorCache {
     }
 
     /// The entries held: (spectral data, grid exponentials, forcing data), each at most
-    /// [`CAPACITY`].
+    /// `CAPACITY`.
     pub fn len(&self) -> (usize, usize, usize) {
         fn n<V>(t: &Table<V>) -> usize {
             t.lock().map_or(0, |e| e.len())

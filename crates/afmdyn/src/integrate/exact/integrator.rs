@@ -170,9 +170,7 @@ impl AffineRegions for ExactPropagator {
         self.spec[r.index()].modal.is_some()
     }
     /// T⁻¹ V e^{Λt} V⁻¹ T from the eigendecomposition (accurate for any t ≥ 0: Re λ_k ≤ 0 and
-    /// the basis is well conditioned, [`modal::MAX_MODAL_CONDITION`]).
-    ///
-    /// [`modal::MAX_MODAL_CONDITION`]: super::MAX_MODAL_CONDITION
+    /// the basis is well conditioned, `modal::MAX_MODAL_CONDITION`).
     fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
         let Some(me) = &self.spec[r.index()].modal else {
             return false;

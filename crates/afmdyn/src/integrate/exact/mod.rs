@@ -52,7 +52,7 @@
 
 mod bound;
 mod build;
-pub mod cache;
+pub(crate) mod cache;
 mod energy;
 mod forcing;
 mod handoff;
@@ -74,7 +74,6 @@ mod tip;
 pub(crate) use crate::linalg::matmul_into;
 pub use build::{ExactOptions, Propagation};
 pub use cache::PropagatorCache;
-pub use modal::MAX_MODAL_CONDITION;
 
 use super::grid::PeriodGrid;
 use super::ChatterWindow;

@@ -19,7 +19,7 @@ use wide::f64x2;
 pub(super) const MAXD: usize = 2 * crate::params::MAX_MODES;
 
 /// Largest accepted condition number ‖V‖_F ‖V⁻¹‖_F of the eigenvector basis.
-pub const MAX_MODAL_CONDITION: f64 = 1e4;
+pub(crate) const MAX_MODAL_CONDITION: f64 = 1e4;
 
 type C = Complex<f64>;
 

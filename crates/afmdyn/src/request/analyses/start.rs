@@ -128,7 +128,7 @@ impl IntegratorRequest {
 ///
 /// # Errors
 /// [`SimError::StateLength`] for a length other than 2N, [`SimError::OutOfRange`] naming
-/// `initial` for an entry not finite or at or above [`MAX_INITIAL_ENTRY`].
+/// `initial` for an entry not finite or at or above `MAX_INITIAL_ENTRY`.
 pub fn initial_state(
     model: &CantileverModel,
     initial: Option<&[f64]>,
@@ -202,7 +202,10 @@ impl StartRequest {
     ///
     /// # Errors
     /// As [`SteadyRequest::options`].
-    pub fn searched(&self, model: &CantileverModel) -> Result<Option<(usize, usize)>, SimError> {
+    pub(crate) fn searched(
+        &self,
+        model: &CantileverModel,
+    ) -> Result<Option<(usize, usize)>, SimError> {
         let steady = self.steady.options()?;
         Ok(self
             .initial

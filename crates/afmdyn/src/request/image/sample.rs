@@ -215,7 +215,7 @@ impl SampleMap {
     /// # Errors
     /// [`SimError::Probe`] naming the file and the key (`size`, `domain 'soft' x`, …) and what
     /// it must be: an unknown key, a missing `size` or `x`, a range that is empty or outside the
-    /// map, more than [`MAX_DOMAINS`] domains; the syntax error of invalid TOML; a height map
+    /// map, more than `MAX_DOMAINS` domains; the syntax error of invalid TOML; a height map
     /// file's refusals ([`crate::io::height_map::read`]), or, without the `files` feature, any
     /// height map file.
     pub fn parse(text: &str, origin: &str) -> Result<SampleMap, SimError> {
@@ -285,7 +285,7 @@ impl SampleMap {
     /// # Errors
     /// As [`SampleMap::load`] and [`SampleMap::parse`].
     #[cfg(feature = "files")]
-    pub fn read(source: &str) -> Result<SampleMap, SimError> {
+    pub(crate) fn read(source: &str) -> Result<SampleMap, SimError> {
         if source.contains(['\n', '=']) {
             Self::parse(source, "<text>")
         } else {
@@ -312,7 +312,8 @@ impl SampleMap {
     /// # Errors
     /// [`SimError::Probe`] naming `height_map`: empty, rows of different lengths, more than
     /// 4096 × 4096 values, a height not finite or beyond ±10 µm.
-    pub fn with_height_map(mut self, rows: Vec<Vec<f64>>) -> Result<SampleMap, SimError> {
+    #[cfg(feature = "files")]
+    pub(crate) fn with_height_map(mut self, rows: Vec<Vec<f64>>) -> Result<SampleMap, SimError> {
         let v = toml::Value::Array(
             rows.into_iter()
                 .map(|r| toml::Value::Array(r.into_iter().map(toml::Value::Float).collect()))

@@ -32,7 +32,7 @@ fn period_short(period: Option<usize>) -> String {
 /// # Errors
 /// [`SimError`] when the model or the request's integrator cannot be built, or a recording
 /// fails.
-pub fn attractors(
+pub(crate) fn attractors(
     request: &AttractorsRequest,
     p: &Params,
     report: &AttractorReport,
@@ -194,7 +194,7 @@ fn summary(
 }
 
 /// The warning of failed random starts of a census of `samples`, if any.
-pub fn failed_starts(report: &AttractorReport, samples: usize) -> Option<String> {
+pub(crate) fn failed_starts(report: &AttractorReport, samples: usize) -> Option<String> {
     report.failures.first().map(|first| {
         format!(
             "{} of {samples} random starts failed; the first: {first}",
@@ -206,7 +206,7 @@ pub fn failed_starts(report: &AttractorReport, samples: usize) -> Option<String>
 /// `attractors --sweep`: `attractors-sweep.csv` (one row per value and attractor), the
 /// dataset `attractors-sweep.nc`, the stacked basin fractions, `attractors-sweep.json`
 /// (`document`) and the summary (per value, each id with its period and basin).
-pub fn global_continuation(
+pub(crate) fn global_continuation(
     request: &GlobalContinuationRequest,
     steps: &[ContinuationStep],
     document: &Value,

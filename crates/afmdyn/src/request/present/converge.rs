@@ -8,7 +8,7 @@ use crate::report::Presentation;
 
 /// `converge`: `converge.csv` (W(1,τ) of every N over the common samples, τ from the first
 /// run's section point), the figure of paper Fig. 4 and the table of periods and RMS changes.
-pub fn converge(p: &Params, runs: &[ConvergenceRun]) -> Presentation {
+pub(crate) fn converge(p: &Params, runs: &[ConvergenceRun]) -> Presentation {
     let mut s = Presentation::default();
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
     let mut header = vec!["tau_from_section".to_string()];

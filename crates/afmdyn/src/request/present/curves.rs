@@ -16,7 +16,7 @@ use serde_json::Value;
 
 /// Which stepped curve is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CurveKind {
+pub(crate) enum CurveKind {
     /// An approach curve over z_c (`approach`, `bimodal`).
     Approach,
     /// A resonance curve over the drive frequency.
@@ -25,7 +25,7 @@ pub enum CurveKind {
 
 /// A stepped curve's presentation: the summary (with the setpoint's operating points of an
 /// approach curve's document), and per `options` the table, figures and traces.
-pub fn stepped(
+pub(crate) fn stepped(
     kind: CurveKind,
     model: &Resolved,
     c: &SteppedCurve,

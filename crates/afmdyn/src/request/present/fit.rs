@@ -11,7 +11,7 @@ use serde_json::Value;
 use std::path::Path;
 
 /// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
-pub const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
+pub(crate) const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
 
 /// The summary line of the estimate `e` of `name` in `unit`: value ± standard error and the
 /// 95 % interval, the error's two digits setting the decimals of every number where it has
@@ -56,7 +56,7 @@ fn held_line(document: &Value, text: TextUnits) -> Option<String> {
 
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
-pub fn fit(
+pub(crate) fn fit(
     document: &mut Value,
     text: TextUnits,
     files: Files,

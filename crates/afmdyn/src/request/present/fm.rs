@@ -12,7 +12,7 @@ use std::path::Path;
 /// the largest excitation, unstable points and folds), and with `files` the table `fm.csv`,
 /// the figure (all files) and the document `fm.json`; when the files go to `dir`, the document
 /// records the table's path there (`"csv"`, in the document printed too).
-pub fn fm(
+pub(crate) fn fm(
     document: &mut Value,
     (columns, table): (Vec<&str>, Vec<Vec<f64>>),
     text: TextUnits,

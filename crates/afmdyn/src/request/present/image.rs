@@ -138,22 +138,12 @@ fn study_plots(s: &mut Presentation, study: &SetpointStudy) {
     }
 }
 
-/// The document of an ideal-feedback image at `setpoint`, with its setpoint study (as
-/// `"setpoint_study"`) when one was asked for.
-pub fn ideal_document(img: &Image, setpoint: f64, study: Option<&SetpointStudy>) -> Value {
-    let mut json = img.document(setpoint);
-    if let Some(s) = study {
-        json["setpoint_study"] = serde_json::to_value(s).expect("a study serialises");
-    }
-    json
-}
-
 /// The summary document of an ideal-feedback image at `setpoint` (`afmdyn image --json`,
 /// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
-/// ([`crate::request::image_layout::summary`]: per map `min`, `max`, `mean`; per code map the
+/// (`crate::request::image_layout::summary`: per map `min`, `max`, `mean`; per code map the
 /// pixels of each meaning); `feedback`, `setpoint`, `reference_z_c` (m), `materials` with their
 /// operating points, `warnings`, and the setpoint study (`"setpoint_study"`) when one was
-/// asked for. [`ideal_document`] is the document with every pixel.
+/// asked for. `ideal_document` is the document with every pixel.
 pub fn ideal_summary(img: &Image, setpoint: f64, study: Option<&SetpointStudy>) -> Value {
     let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
     let mut json = json!({
@@ -172,7 +162,7 @@ pub fn ideal_summary(img: &Image, setpoint: f64, study: Option<&SetpointStudy>) 
 
 /// The summary document of a PI-scanned image at `setpoint` (`afmdyn image --feedback pi
 /// --json`, `image.json`; the maps are `image.nc`'s): `image`, the maps of trace, retrace and
-/// ideal image summarised ([`crate::request::image_layout::summary`]); `feedback`, `scan` (the
+/// ideal image summarised (`crate::request::image_layout::summary`); `feedback`, `scan` (the
 /// settings), `artefacts` of `trace` and `retrace`, `setpoint`, `reference_z_c` (m),
 /// `materials`, `warnings`. [`PiImage::document`] is the document with every pixel.
 pub fn pi_summary(img: &PiImage, setpoint: f64) -> Value {
@@ -193,7 +183,7 @@ pub fn pi_summary(img: &PiImage, setpoint: f64) -> Value {
 /// `image.json` (`document`: [`ideal_summary`], or [`ideal_document`]), `image.nc`, the maps `image-height`,
 /// `image-phase`, `image-dissipation`, the profile `image-profile`, and the summary: every
 /// material's operating point where it is first met, the study's table.
-pub fn ideal(
+pub(crate) fn ideal(
     img: &Image,
     setpoint: f64,
     study: Option<&SetpointStudy>,
@@ -295,7 +285,7 @@ pub fn ideal(
 /// `image.nc`, the trace's maps (recorded height, error image, phase, E_dis), the first line's
 /// profile (trace, retrace, ideal and true height), and the summary: the settings and each
 /// direction's artefacts.
-pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Presentation {
+pub(crate) fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Presentation {
     let mut s = Presentation::default();
     s.json("image.json", document.clone());
     s.dataset("image.nc", scan_layout(img, setpoint));
@@ -381,7 +371,7 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
 /// the continuations into them, `reengaged`, and `maps`, each of `PF_FIELDS` summarised
 /// over them as [`number_summary`]), `taps`, `warnings`. [`PeakForceImage::document`] is the
 /// document with every pixel.
-pub fn peakforce_summary(img: &PeakForceImage) -> Value {
+pub(crate) fn peakforce_summary(img: &PeakForceImage) -> Value {
     let mut doc = img.document_head();
     doc["image"] = summary(&peakforce_layout(img));
     let cells: Vec<(usize, usize)> = (0..img.y.len())
@@ -413,11 +403,11 @@ pub fn peakforce_summary(img: &PeakForceImage) -> Value {
     doc
 }
 
-/// A PeakForce image: `image.json` (`document`: [`peakforce_summary`], or
+/// A PeakForce image: `image.json` (`document`: `peakforce_summary`, or
 /// [`PeakForceImage::document`]), `image.nc`, the maps `image-height`, `image-modulus`,
 /// `image-adhesion`, `image-deformation`, `image-dissipation`, and the summary: every
 /// material's engaged operating point beside its true modulus.
-pub fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
+pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
     let mut s = Presentation::default();
     s.json("image.json", document.clone());
     s.dataset("image.nc", peakforce_layout(img));

@@ -165,7 +165,7 @@ fn chart_maps(s: &mut Presentation, chart: &Chart, a: &ChartArrays) {
 /// A finished chart: `chart.csv` (every attractor of every cell), `chart.nc` (the arrays of
 /// [`ChartArrays`]), the maps `chart-period`, `chart-lyapunov`, `chart-attractors`, and the
 /// summary (the cells with coexisting attractors and without any).
-pub fn chart(chart: &Chart, cells: &[ChartCell]) -> Presentation {
+pub(crate) fn chart(chart: &Chart, cells: &[ChartCell]) -> Presentation {
     let mut s = Presentation::default();
     let mut text = CSV_HEADER.join(",");
     text.push('\n');

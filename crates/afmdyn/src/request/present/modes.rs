@@ -92,12 +92,12 @@ pub(crate) fn modes(
 }
 
 /// The α1 values of the Fig. 3 sweep: 0 to 0.5 by 0.05.
-pub fn fig3_alpha1() -> Vec<f64> {
+pub(crate) fn fig3_alpha1() -> Vec<f64> {
     (0..=10).map(|i| 0.05 * i as f64).collect()
 }
 
 /// The α4 values of the Fig. 3 sweep: 0 to 200 by 2.
-pub fn fig3_alpha4() -> Vec<f64> {
+pub(crate) fn fig3_alpha4() -> Vec<f64> {
     (0..=100).map(|i| 2.0 * i as f64).collect()
 }
 
@@ -105,7 +105,7 @@ pub fn fig3_alpha4() -> Vec<f64> {
 /// ω₂/ω₀₂ over α4, a line for every other α1) at `modes` modes; no summary (the front end
 /// says where it wrote them).
 #[cfg(feature = "files")]
-pub fn fig3(modes: usize, pts: &[crate::eigen::Fig3Point]) -> Presentation {
+pub(crate) fn fig3(modes: usize, pts: &[crate::eigen::Fig3Point]) -> Presentation {
     use crate::layout::figure::{Figure, Plot, Series, Style};
     use crate::layout::files::f;
     let mut s = Presentation::default();
@@ -167,7 +167,7 @@ pub fn fig3(modes: usize, pts: &[crate::eigen::Fig3Point]) -> Presentation {
 }
 
 /// `units --config`: the dimensionless set of a physical model (eq. 7) and its scales (eq. 5).
-pub fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
+pub(crate) fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
     let mut s = Presentation::default();
     let k1 = model.contact_stiffness;
     s.line("dimensionless parameters (eq. 7):");
@@ -197,7 +197,7 @@ pub fn units(model: &PhysicalModel, p: &Params, sc: &Scales) -> Presentation {
 }
 
 /// `cantilevers`: the library of cantilevers, one line each, and how to use them.
-pub fn cantilevers() -> Presentation {
+pub(crate) fn cantilevers() -> Presentation {
     let mut s = Presentation::default();
     s.line(format!(
         "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",

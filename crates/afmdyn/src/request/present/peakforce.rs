@@ -13,7 +13,7 @@ use std::path::Path;
 pub(crate) const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
 /// The columns of the force–distance curve's table (`peakforce-curve.csv`): approach and
 /// retract side by side (the retract has as many points as the approach, or one more).
-pub const CURVE_COLUMNS: [&str; 4] = [
+pub(crate) const CURVE_COLUMNS: [&str; 4] = [
     "approach_distance",
     "approach_force",
     "retract_distance",
@@ -34,7 +34,7 @@ fn column(doc: &Value, block: &str, name: &str) -> Vec<f64> {
 
 /// The rows of one table of the document: `block`'s arrays in `columns` order, as long as the
 /// longest (NaN beyond a shorter one).
-pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
+pub(crate) fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
     let cols: Vec<Vec<f64>> = columns.iter().map(|c| column(doc, block, c)).collect();
     let n = cols.iter().map(Vec::len).max().unwrap_or(0);
     (0..n)
@@ -80,7 +80,7 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
 /// The presentation of a steady tap's `document` ([`crate::request::peakforce::document`]):
 /// the summary, and with `files` the two tables, the figures (all files) and the document
 /// `peakforce.json`.
-pub fn peakforce(
+pub(crate) fn peakforce(
     document: &mut Value,
     text: TextUnits,
     files: Files,

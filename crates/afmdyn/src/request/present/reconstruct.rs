@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// Where a reconstruction comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Inversion {
+pub(crate) enum Inversion {
     /// An FM curve by the Sader–Jarvis inversion.
     SaderJarvis,
     /// An AM curve by the matrix method.
@@ -24,7 +24,7 @@ pub enum Inversion {
 /// figure (all files; with the model's force `law` in the curve's order when known) and the
 /// document `reconstruct.json`; when the files go to `dir`, the document records the table's
 /// path there (`"csv"`, in the document printed too).
-pub fn reconstruction(
+pub(crate) fn reconstruction(
     r: &Reconstruction,
     how: Inversion,
     law: Option<Vec<f64>>,

@@ -3,9 +3,12 @@
 //! records in memory or from the store's CSV (a diagram is streamed from the store by a front
 //! end); `attractors` and `attractors --sweep`: their summaries, tables and figures.
 
+#[cfg(feature = "files")]
 use crate::error::SimError;
 use crate::params::{Params, SweepParam};
-use crate::request::sweep::{sweep_failure, SweepRecord, COL_W_TIP, COL_X_MAX};
+use crate::request::sweep::SweepRecord;
+#[cfg(feature = "files")]
+use crate::request::sweep::{sweep_failure, COL_W_TIP, COL_X_MAX};
 use serde_json::{json, Value};
 use std::collections::HashSet;
 
@@ -24,7 +27,7 @@ pub(crate) fn period_color(period: f64) -> usize {
 
 /// What the tally and the diagrams read of a sweep's row.
 #[derive(Debug, Clone, Copy)]
-pub struct SweepRow<'a> {
+pub(crate) struct SweepRow<'a> {
     /// The parameter's value.
     pub value: f64,
     /// W(1,τ) at the Poincaré point (NaN: none).
@@ -40,9 +43,11 @@ pub struct SweepRow<'a> {
     /// A failed point's message.
     pub message: &'a str,
     /// The palette index of how the point was reached: forward 0, backward 1, a start 7.
+    #[cfg(feature = "files")]
     pub branch: usize,
 }
 
+#[cfg(feature = "files")]
 fn branch_color(branch: &str) -> usize {
     match branch {
         "forward" => 0,
@@ -53,7 +58,7 @@ fn branch_color(branch: &str) -> usize {
 
 impl<'a> SweepRow<'a> {
     /// The row of a record.
-    pub fn of(r: &'a SweepRecord) -> Self {
+    pub(crate) fn of(r: &'a SweepRecord) -> Self {
         SweepRow {
             value: r.value,
             w_tip: r.w_tip,
@@ -62,13 +67,14 @@ impl<'a> SweepRow<'a> {
             code: r.status.code() as f64,
             first: r.point == 0,
             message: &r.message,
+            #[cfg(feature = "files")]
             branch: branch_color(&r.branch.to_string()),
         }
     }
 
     /// The row of a line of the store's CSV (unreadable numbers as NaN).
     #[cfg(feature = "files")]
-    pub fn from_csv(r: &'a csv::StringRecord) -> Self {
+    pub(crate) fn from_csv(r: &'a csv::StringRecord) -> Self {
         use crate::request::sweep::*;
         let num = |c: usize| r[c].parse().unwrap_or(f64::NAN);
         SweepRow {
@@ -116,7 +122,8 @@ impl Default for SweepTally {
 }
 
 /// The diagrams of a sweep: stem, column drawn, title, y label, coloured by branch.
-pub const BIFURCATION_FIGURES: [(&str, usize, &str, &str, bool); 3] = [
+#[cfg(feature = "files")]
+pub(crate) const BIFURCATION_FIGURES: [(&str, usize, &str, &str, bool); 3] = [
     (
         "bifurcation",
         COL_W_TIP,
@@ -141,11 +148,12 @@ pub const BIFURCATION_FIGURES: [(&str, usize, &str, &str, bool); 3] = [
 ];
 
 /// A legend entry: label, palette index, drawn as a marker.
+#[cfg(feature = "files")]
 pub(crate) type Legend = (String, usize, bool);
 
 impl SweepTally {
     /// Count a row.
-    pub fn add_row(&mut self, r: SweepRow<'_>) {
+    pub(crate) fn add_row(&mut self, r: SweepRow<'_>) {
         if r.w_tip.is_finite() || r.x_max.is_finite() {
             self.drawn.insert(period_color(r.code));
         }
@@ -174,6 +182,7 @@ impl SweepTally {
 
     /// The bounds (x0, x1, y0, y1) of the diagram of `column` (W(1,τ) or X_max); the unit
     /// square when no row is drawn.
+    #[cfg(feature = "files")]
     pub fn bounds(&self, column: usize) -> (f64, f64, f64, f64) {
         let [x, w, m] = self.bounds;
         let y = if column == COL_W_TIP { w } else { m };
@@ -185,6 +194,7 @@ impl SweepTally {
     }
 
     /// The legend of the diagrams coloured by period: the classes drawn.
+    #[cfg(feature = "files")]
     pub fn legend(&self) -> Vec<Legend> {
         [
             ("period 1", 1.0),
@@ -215,6 +225,7 @@ impl SweepTally {
     }
 
     /// [`SimError::EveryRunFailed`] when no point was computed ([`sweep_failure`]).
+    #[cfg(feature = "files")]
     pub fn failure(&self) -> Option<SimError> {
         sweep_failure(
             self.periodic + self.nonperiodic,
@@ -224,6 +235,7 @@ impl SweepTally {
     }
 
     /// The warning of failed points, if any.
+    #[cfg(feature = "files")]
     pub fn warning(&self) -> Option<String> {
         self.first_error.as_ref().map(|first| {
             format!(
@@ -236,6 +248,7 @@ impl SweepTally {
 
     /// The summary line of `values` values of `param` (the front end adds where the outputs
     /// are).
+    #[cfg(feature = "files")]
     pub fn summary(&self, values: usize, param: SweepParam) -> String {
         format!(
             "{} values of {}: {} periodic, {} nonperiodic, {} failed points",
@@ -301,7 +314,10 @@ impl crate::layout::figure::PointSource for StoredDiagram {
 /// directory at its end), the warning of failed points, and the diagrams
 /// ([`BIFURCATION_FIGURES`]) streamed from the store's CSV.
 #[cfg(feature = "files")]
-pub fn stored_bifurcation(files: &SweepFiles, param: SweepParam) -> crate::report::Presentation {
+pub(crate) fn stored_bifurcation(
+    files: &SweepFiles,
+    param: SweepParam,
+) -> crate::report::Presentation {
     use crate::layout::figure::{Plot, StreamedScatter};
     let (spec, tally) = (&files.spec, &files.tally);
     let mut p = crate::report::Presentation {
@@ -339,7 +355,8 @@ pub fn stored_bifurcation(files: &SweepFiles, param: SweepParam) -> crate::repor
 
 /// The legend of the diagram coloured by branch: the continuations and the random starts of a
 /// sweep that has them.
-pub fn branch_legend(continuation: bool, starts: u32) -> Vec<Legend> {
+#[cfg(feature = "files")]
+pub(crate) fn branch_legend(continuation: bool, starts: u32) -> Vec<Legend> {
     let mut legend: Vec<Legend> = Vec::new();
     if continuation {
         legend.push(("forward continuation".into(), 0, true));
@@ -353,7 +370,12 @@ pub fn branch_legend(continuation: bool, starts: u32) -> Vec<Legend> {
 
 /// The point a row draws on a diagram of `column` ([`BIFURCATION_FIGURES`]): (value, y,
 /// palette index by branch or by period class); none without a finite y.
-pub fn diagram_point(r: SweepRow<'_>, column: usize, by_branch: bool) -> Option<(f64, f64, usize)> {
+#[cfg(feature = "files")]
+pub(crate) fn diagram_point(
+    r: SweepRow<'_>,
+    column: usize,
+    by_branch: bool,
+) -> Option<(f64, f64, usize)> {
     let y = if column == COL_W_TIP {
         r.w_tip
     } else {
