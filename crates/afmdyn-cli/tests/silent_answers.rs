@@ -337,3 +337,47 @@ fn a_probes_warnings_reach_stderr() {
         "{err}"
     );
 }
+
+/// The probe's own warnings reach an AM image as they reach `approach` and a PeakForce image
+/// (issue 77: the AM image lacked them): the point-mass example on a 50 MPa DMT sample
+/// (Hamaker 6.6e-20 J, R = 10 nm: a Tabor parameter of ≈ 14, in JKR's regime), named by its
+/// material, in the document and on stderr.
+#[test]
+fn an_am_image_carries_the_probes_warnings() {
+    let text = std::fs::read_to_string(common::repo().join("examples/probe-point-mass-dmt.toml"))
+        .unwrap()
+        .replace("youngs_modulus = 4e9", "youngs_modulus = 50e6");
+    assert!(text.contains("youngs_modulus = 50e6"));
+    let probe = probe_file("am-image-tabor", &text);
+    let sample = probe.with_file_name("flat.toml");
+    std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
+    let out = run(&[
+        "image",
+        "--probe",
+        probe.to_str().unwrap(),
+        "--sample",
+        sample.to_str().unwrap(),
+        "--setpoint",
+        "0.7",
+        "--pixels",
+        "2",
+        "--curve-points",
+        "40",
+        "--json",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let tabor = |w: &str| w.starts_with("background: ") && w.contains("Tabor parameter");
+    assert!(
+        doc["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| tabor(w.as_str().unwrap())),
+        "{doc}"
+    );
+    assert!(err.contains("Tabor parameter"), "{err}");
+}

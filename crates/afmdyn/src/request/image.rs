@@ -365,6 +365,9 @@ pub(crate) struct MaterialCurve {
     pub(crate) curve: crate::analysis::stepped::SteppedCurve,
     /// The curve's spec (its operating points are refined with it).
     pub(crate) spec: SteppedSpec,
+    /// Its probe's own warnings ([`Probe::warnings`]: a sample outside its law's regime, a
+    /// value outside its typical range), named by the material.
+    pub(crate) probe_warnings: Vec<String>,
 }
 
 /// The approach curve of `params` (`curve_points` z_c values each way over the probe's default
@@ -439,26 +442,28 @@ pub(crate) fn material_curves(
     let background = background_probe(probe_table)?;
     let units = CurveUnits::from_scales(&background.scales, false);
     check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
-    let (models, of_domain, _) = material_models(probe_table, map, &background)?;
+    let (models, of_domain, warnings) = material_models(probe_table, map, &background)?;
     let materials = models
         .into_iter()
-        .map(|(name, params)| {
+        .zip(warnings)
+        .map(|((name, params), probe_warnings)| {
             let (spec, curve) = approach_curve(params, &units, curve_points)?;
             Ok(MaterialCurve {
                 name,
                 params,
                 curve,
                 spec,
+                probe_warnings,
             })
         })
         .collect::<Result<Vec<_>, SimError>>()?;
     Ok((materials, of_domain, units))
 }
 
-/// The materials' (name, model) of a sample map, the material of each of its domains, and the
-/// materials' own probe warnings ([`Probe::warnings`], each named by its material: a domain's
-/// only where the background's does not say it).
-pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>, Vec<String>);
+/// The materials' (name, model) of a sample map, the material of each of its domains, and each
+/// material's own probe warnings ([`Probe::warnings`], named by the material: a domain's only
+/// where the background's does not say it).
+pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>, Vec<Vec<String>>);
 
 /// The models of `map`'s materials under the probe table `probe_table` (its background
 /// `background`): the background, then one per domain with its own sample (name, model: the
@@ -474,7 +479,7 @@ pub(crate) fn material_models(
     let mut models = vec![("background".to_string(), background.params)];
     let mut of_domain = Vec::with_capacity(map.domains.len());
     let own = background.warnings();
-    let mut warnings: Vec<String> = own.iter().map(|w| format!("background: {w}")).collect();
+    let mut warnings = vec![own.iter().map(|w| format!("background: {w}")).collect()];
     for d in &map.domains {
         let Some(sample) = &d.sample else {
             of_domain.push(0);
@@ -488,7 +493,7 @@ pub(crate) fn material_models(
         of_domain.push(models.len());
         models.push((d.name.clone(), probe.params));
         let new = probe.warnings().into_iter().filter(|w| !own.contains(w));
-        warnings.extend(new.map(|w| format!("{}: {w}", d.name)));
+        warnings.push(new.map(|w| format!("{}: {w}", d.name)).collect());
     }
     Ok((models, of_domain, warnings))
 }
@@ -621,8 +626,13 @@ pub(crate) fn image_of(
         })
         .collect::<Result<_, SimError>>()?;
     let (x, y) = pixel_grid(map, req);
-    // the approach curves' own warnings (an unsettled point, a failed one), named by material
-    let mut warnings = curve_warnings(curves);
+    // the materials' probe warnings (issue 77: the AM image lacked them), then their approach
+    // curves' own (an unsettled point, a failed one), named by material
+    let mut warnings: Vec<String> = curves
+        .iter()
+        .flat_map(|m| m.probe_warnings.clone())
+        .collect();
+    warnings.extend(curve_warnings(curves));
     for m in &materials {
         if m.points.is_empty() {
             warnings.push(format!(

@@ -270,7 +270,7 @@ impl PeakForceImageStudy {
             materials,
             of_domain,
             setpoint: req.setpoint / units.force,
-            probe_warnings,
+            probe_warnings: probe_warnings.concat(),
             units,
             options: PeakForceOptions::default(),
             fingerprint,
