@@ -52,8 +52,12 @@ impl Integrator for ExactPropagator {
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
         let mut out = DVector::zeros(self.z.len());
-        self.state_in_last(tau - self.last.tau0, out.as_mut_slice());
+        self.dense_state_into(tau, out.as_mut_slice());
         out
+    }
+
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
+        self.state_in_last(tau - self.last.tau0, out);
     }
 
     // the sample sequence and its accuracy: `sample.rs`
