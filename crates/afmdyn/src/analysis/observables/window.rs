@@ -192,8 +192,8 @@ impl Ctx {
     /// the sine and cosine of Ωτ computed once for the drive, the state's rate and V_T.
     pub(super) fn node_into(&self, integ: &mut dyn Integrator, r: Region, tau: f64, nd: &mut Node) {
         let n = self.model.modes();
-        integ.dense_state_into(tau, nd.z.as_mut_slice());
         let sc = (self.omega * tau).sin_cos();
+        integ.dense_state_at(tau, sc, nd.z.as_mut_slice());
         nd.dz.fill(0.0);
         self.model
             .rhs_slice_at(r, tau, sc, nd.z.as_slice(), nd.dz.as_mut_slice());

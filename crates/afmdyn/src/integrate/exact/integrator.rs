@@ -60,6 +60,16 @@ impl Integrator for ExactPropagator {
         self.state_in_last(tau - self.last.tau0, out);
     }
 
+    fn dense_state_at(&mut self, tau: f64, sc: (f64, f64), out: &mut [f64]) {
+        let t = tau - self.last.tau0;
+        // `state_in_last` takes sin, cos of Ω(τ0 + t): the caller's where that is τ
+        if self.last.tau0 + t == tau {
+            self.state_in_last_at(t, sc, out);
+        } else {
+            self.state_in_last(t, out);
+        }
+    }
+
     // the sample sequence and its accuracy: `sample.rs`
     fn dense_states_into(&mut self, t0: f64, dt: f64, first: u64, out: &mut [f64]) {
         self.dense_states_impl(t0, dt, first, out);
