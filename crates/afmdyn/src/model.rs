@@ -346,8 +346,20 @@ impl CantileverModel {
 
     /// As [`CantileverModel::rhs`] on slices of length 2N.
     pub(crate) fn rhs_slice(&self, r: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
+        self.rhs_slice_at(r, tau, (self.params.omega * tau).sin_cos(), z, dz);
+    }
+
+    /// As [`CantileverModel::rhs_slice`] given `(s, c)` = (sin Ωτ, cos Ωτ), which a caller
+    /// holding them at τ already need not have computed twice.
+    pub(crate) fn rhs_slice_at(
+        &self,
+        r: Region,
+        tau: f64,
+        (s, c): (f64, f64),
+        z: &[f64],
+        dz: &mut [f64],
+    ) {
         let n = self.modes();
-        let (s, c) = (self.params.omega * tau).sin_cos();
         let linear = self.law.law().is_affine();
         let d = &self.regions[if linear { r.index() } else { 0 }];
         let (zb, dzb) = (&z[..2 * n], &mut dz[..2 * n]);

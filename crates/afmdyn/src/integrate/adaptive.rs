@@ -687,15 +687,22 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
-        let d = self.dim();
-        let Some(mut s) = self.last.dense.take() else {
+        if self.last.dense.is_none() {
             return self.last.hermite.state(tau);
-        };
-        let mut z = DVector::zeros(d);
-        let tau = tau.clamp(s.t_prev(), s.t());
-        self.state_on(&mut s, self.last.region, tau, z.as_mut_slice());
-        self.last.dense = Some(s);
+        }
+        let mut z = DVector::zeros(self.dim());
+        self.dense_state_into(tau, z.as_mut_slice());
         z
+    }
+
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
+        let Some(mut s) = self.last.dense.take() else {
+            out.copy_from_slice(self.last.hermite.state(tau).as_slice());
+            return;
+        };
+        let tau = tau.clamp(s.t_prev(), s.t());
+        self.state_on(&mut s, self.last.region, tau, out);
+        self.last.dense = Some(s);
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {

@@ -179,10 +179,18 @@ pub trait Integrator: Send {
     /// Full state at `tau` inside the last step, shape `[2N]`.
     fn dense_state(&mut self, tau: f64) -> DVector<f64>;
     /// [`Integrator::dense_state`] written into `out` (shape `[2N]`, the state's length), bit
-    /// for bit: the default copies it; the Taylor integrator allocates nothing (the lock-in's
-    /// 32 samples per drive period, `dense::sample_dense`).
+    /// for bit: the default copies it; the Taylor, exact and adaptive integrators allocate
+    /// nothing (the lock-in's 32 samples per drive period, `dense::sample_dense`; the nodes
+    /// of the observables' quadrature).
     fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
         out.copy_from_slice(self.dense_state(tau).as_slice());
+    }
+    /// [`Integrator::dense_state_into`] given `sc` = (sin Ωτ, cos Ωτ) at `tau`, which the
+    /// caller holds, bit for bit: the default ignores it; the exact propagator's forced part
+    /// takes it instead of its own where its step's local time gives τ back exactly.
+    fn dense_state_at(&mut self, tau: f64, sc: (f64, f64), out: &mut [f64]) {
+        let _ = sc;
+        self.dense_state_into(tau, out);
     }
     /// The states at the sample times τ_i = t0 + i·dt, i = `first`, `first` + 1, …, all inside
     /// the last step, into `out` (one row of 2N values per sample, `out.len()` a multiple of

@@ -303,6 +303,14 @@ impl Integrator for Split {
         self.integ_mut(self.last).dense_state(tau)
     }
 
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
+        self.integ_mut(self.last).dense_state_into(tau, out);
+    }
+
+    fn dense_state_at(&mut self, tau: f64, sc: (f64, f64), out: &mut [f64]) {
+        self.integ_mut(self.last).dense_state_at(tau, sc, out);
+    }
+
     /// The exact half's closed form over its whole grid steps of free flight (where the
     /// model's rates are those of the linear law's region I: no tip force), the Taylor
     /// contact's from its series.

@@ -23,6 +23,22 @@ pub(super) struct Node {
     sc: (f64, f64),
 }
 
+impl Node {
+    /// A node of states of length `dim`, for [`Ctx::node_into`] to fill.
+    fn zeros(dim: usize) -> Self {
+        Node {
+            tau: 0.0,
+            z: DVector::zeros(dim),
+            dz: DVector::zeros(dim),
+            w: 0.0,
+            wd: 0.0,
+            v: [0.0; 3],
+            f: 0.0,
+            sc: (0.0, 0.0),
+        }
+    }
+}
+
 /// What [`observe`] needs of the model, computed once.
 pub(super) struct Ctx {
     model: CantileverModel,
@@ -167,24 +183,24 @@ impl Ctx {
     /// The dense output of the last step (region `r`) at τ: V_T, W and F_c from one sine and
     /// cosine of Ωτ, which the harmonics and the drive's work reuse.
     pub(super) fn node(&self, integ: &mut dyn Integrator, r: Region, tau: f64) -> Node {
+        let mut nd = Node::zeros(integ.state().len());
+        self.node_into(integ, r, tau, &mut nd);
+        nd
+    }
+
+    /// [`Ctx::node`] written into `nd` (its states' length the state's): no allocation, and
+    /// the sine and cosine of Ωτ computed once for the drive, the state's rate and V_T.
+    pub(super) fn node_into(&self, integ: &mut dyn Integrator, r: Region, tau: f64, nd: &mut Node) {
         let n = self.model.modes();
-        let z = integ.dense_state(tau);
-        let mut dz = DVector::zeros(z.len());
-        self.model.rhs(r, tau, &z, &mut dz);
         let sc = (self.omega * tau).sin_cos();
-        let [_, w, wd, f] = self.model.sample_values(r, tau, sc, z.as_slice());
-        let wdd = self.tip.dot(&dz.rows(n, n));
-        let v = self.model.v_t_at(sc, [w, wd, wdd]);
-        Node {
-            tau,
-            z,
-            dz,
-            w,
-            wd,
-            v,
-            f,
-            sc,
-        }
+        integ.dense_state_at(tau, sc, nd.z.as_mut_slice());
+        nd.dz.fill(0.0);
+        self.model
+            .rhs_slice_at(r, tau, sc, nd.z.as_slice(), nd.dz.as_mut_slice());
+        let [_, w, wd, f] = self.model.sample_values(r, tau, sc, nd.z.as_slice());
+        let wdd = self.tip.dot(&nd.dz.rows(n, n));
+        nd.v = self.model.v_t_at(sc, [w, wd, wdd]);
+        (nd.tau, nd.w, nd.wd, nd.f, nd.sc) = (tau, w, wd, f, sc);
     }
 
     /// dF_c/dτ at `nd` (τ = `t` in the piece [lo, hi]): analytic for the smooth laws
@@ -227,6 +243,8 @@ pub(super) fn off_diagonal(m: &DMatrix<f64>, j: usize, x: &[f64]) -> f64 {
 /// last piece's end node (τ, dF_c/dτ, dV_T/dτ), which starts the next piece of the same step.
 pub(super) struct Scratch {
     fi: DVector<f64>,
+    /// The node under evaluation ([`Ctx::node_into`]).
+    node: Node,
     scan: Vec<(f64, f64, f64)>,
     start: Option<(f64, f64, f64)>,
 }
@@ -393,9 +411,10 @@ impl Acc {
         match scratch.start.take() {
             Some(start) if start.0 == a => scan.push(start),
             _ => {
-                let nd = ctx.node(integ, r, a);
+                let nd = &mut scratch.node;
+                ctx.node_into(integ, r, a, nd);
                 self.extremes(nd.f, nd.v[0]);
-                scan.push((a, ctx.rate(integ, r, a, &nd, a, b), nd.v[1]));
+                scan.push((a, ctx.rate(integ, r, a, nd, a, b), nd.v[1]));
             }
         }
         // the short rule where a product of two factors has |c| ≤ 1 on the piece (module docs),
@@ -403,24 +422,27 @@ impl Acc {
         let short = integ.smooth_time().is_none() && half * ctx.product_rate[r.index()] <= 1.0;
         for &(x, wx) in &ctx.gl[usize::from(short)] {
             let (tau, dtau) = crate::integrate::smooth_time(integ, a, b, 0.5 * (x + 1.0));
-            let nd = ctx.node(integ, r, tau);
-            self.quadrature(ctx, 0.5 * wx * dtau, &nd, &mut scratch.fi);
+            let nd = &mut scratch.node;
+            ctx.node_into(integ, r, tau, nd);
+            self.quadrature(ctx, 0.5 * wx * dtau, nd, &mut scratch.fi);
             self.extremes(nd.f, nd.v[0]);
-            scan.push((tau, ctx.rate(integ, r, tau, &nd, a, b), nd.v[1]));
+            scan.push((tau, ctx.rate(integ, r, tau, nd, a, b), nd.v[1]));
         }
-        let nd = ctx.node(integ, r, b);
+        let nd = &mut scratch.node;
+        ctx.node_into(integ, r, b, nd);
         self.extremes(nd.f, nd.v[0]);
-        scan.push((b, ctx.rate(integ, r, b, &nd, a, b), nd.v[1]));
+        scan.push((b, ctx.rate(integ, r, b, nd, a, b), nd.v[1]));
         scratch.start = scan.last().copied();
         for pair in scan.windows(2) {
             let ((ta, fda, vda), (tb, fdb, vdb)) = (pair[0], pair[1]);
             if (fda > 0.0) != (fdb > 0.0) {
+                let nd = &mut scratch.node;
                 let mut g = |t: f64| {
-                    let nd = ctx.node(integ, r, t);
-                    ctx.rate(integ, r, t, &nd, a, b)
+                    ctx.node_into(integ, r, t, nd);
+                    ctx.rate(integ, r, t, nd, a, b)
                 };
                 let t = root_of(ta, fda, tb, fdb, &mut g);
-                let nd = ctx.node(integ, r, t);
+                ctx.node_into(integ, r, t, nd);
                 self.extremes(nd.f, nd.v[0]);
             }
             if vda < 0.0 && vdb > 0.0 {
@@ -619,6 +641,7 @@ impl Ctx {
         let tau_start = integ.tau();
         let mut scratch = Scratch {
             fi: DVector::zeros(self.model.modes()),
+            node: Node::zeros(integ.state().len()),
             scan: Vec::with_capacity(GL_NODES + 2),
             start: None,
         };

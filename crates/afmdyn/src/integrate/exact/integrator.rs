@@ -52,8 +52,22 @@ impl Integrator for ExactPropagator {
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
         let mut out = DVector::zeros(self.z.len());
-        self.state_in_last(tau - self.last.tau0, out.as_mut_slice());
+        self.dense_state_into(tau, out.as_mut_slice());
         out
+    }
+
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
+        self.state_in_last(tau - self.last.tau0, out);
+    }
+
+    fn dense_state_at(&mut self, tau: f64, sc: (f64, f64), out: &mut [f64]) {
+        let t = tau - self.last.tau0;
+        // `state_in_last` takes sin, cos of Ω(τ0 + t): the caller's where that is τ
+        if self.last.tau0 + t == tau {
+            self.state_in_last_at(t, sc, out);
+        } else {
+            self.state_in_last(t, out);
+        }
     }
 
     // the sample sequence and its accuracy: `sample.rs`
