@@ -592,3 +592,41 @@ fn peakforce_modulation_bound_is_relative_to_the_first_resonance() {
     assert!(check(pm, 0.4).is_ok());
     assert!(check(pm, 0.6).is_err());
 }
+
+/// The integrator's budget of steps per modulation period is held before any work and names
+/// the modulation frequency (issue 77 §7: `peakforce` at f_m = 30 Hz on the 70 kHz air lever
+/// was refused with "taylor integrator: about 3.15e7 steps … (use the exact integrator …)",
+/// an option it does not have): the refusal names `modulation_frequency` and the lowest f_m
+/// that fits, and the steps scale as 1/f_m, so that f_m (1 % above it) is admitted.
+#[test]
+fn a_modulation_too_slow_for_the_integrator_is_refused_by_its_key() {
+    use afmdyn::request::{PeakForceRequest, Resolved};
+    let text = std::fs::read_to_string(AIR).unwrap();
+    let at = |f: f64| {
+        let probe = afmdyn::probe::Probe::parse(
+            &text.replace(
+                "modulation_frequency = 2e3",
+                &format!("modulation_frequency = {f}"),
+            ),
+            "air",
+        )
+        .unwrap();
+        let model = Resolved {
+            params: probe.params,
+            probe: Some(probe),
+        };
+        PeakForceRequest::default().params(&model)
+    };
+    assert!(text.contains("modulation_frequency = 2e3"));
+    let e = at(30.0).unwrap_err().to_string();
+    assert!(e.starts_with("modulation_frequency = 30 Hz: "), "{e}");
+    let f_min: f64 = e
+        .split("give modulation_frequency ≥ ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{e}"));
+    assert!(f_min > 30.0 && f_min < 2e3, "{e}");
+    assert!(at(1.01 * f_min).is_ok());
+    assert!(at(0.99 * f_min).is_err());
+}

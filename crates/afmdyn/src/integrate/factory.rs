@@ -255,6 +255,27 @@ pub fn build(
     Ok(integ)
 }
 
+/// The steps per drive period a stepping integrator of `kind` (adaptive, split, Taylor) needs
+/// on `model` at most: the fastest rate of its regions (and of an SLS Maxwell arm) times the
+/// drive period; `None` for the exact and RK4 integrators, whose steps the drive sets.
+pub(crate) fn steps_per_period(model: &CantileverModel, kind: IntegratorKind) -> Option<f64> {
+    if !matches!(
+        kind,
+        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Taylor
+    ) {
+        return None;
+    }
+    let rate = [Region::Free, Region::Contact]
+        .iter()
+        .map(|&r| model.dynamics(r).a.norm())
+        .fold(0.0, f64::max)
+        // the SLS Maxwell arm: its relaxation rate and its spring at the tip
+        .max(model.zener().map_or(0.0, |zn| {
+            zn.relaxation_rate() + zn.maxwell * model.tip_mobility().norm()
+        }));
+    Some(rate * model.period())
+}
+
 /// Whether an integrator of `kind` can integrate `model`: an adaptive stepper's steps per drive
 /// period within [`crate::params::ADAPTIVE_STEPS_BUDGET`], one harmonic drive for the exact and
 /// split integrators, no internal states of the law but for the adaptive one, and neither a
@@ -264,19 +285,7 @@ pub fn build(
 /// [`SimError::Budget`], [`SimError::OutOfRange`] naming `integrator`, or
 /// [`SimError::Unsupported`].
 fn check_supported(model: &CantileverModel, kind: IntegratorKind) -> Result<(), SimError> {
-    if matches!(
-        kind,
-        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Taylor
-    ) {
-        let rate = [Region::Free, Region::Contact]
-            .iter()
-            .map(|&r| model.dynamics(r).a.norm())
-            .fold(0.0, f64::max)
-            // the SLS Maxwell arm: its relaxation rate and its spring at the tip
-            .max(model.zener().map_or(0.0, |zn| {
-                zn.relaxation_rate() + zn.maxwell * model.tip_mobility().norm()
-            }));
-        let steps = rate * model.period();
+    if let Some(steps) = steps_per_period(model, kind) {
         if steps.is_nan() || steps > crate::params::ADAPTIVE_STEPS_BUDGET {
             return Err(SimError::Budget {
                 what: match kind {

@@ -44,6 +44,7 @@ mod support;
 pub mod taylor;
 
 pub use exact::PropagatorCache;
+pub(crate) use factory::steps_per_period;
 pub use factory::{
     build, check_buildable, check_buildable_over, check_start, check_tolerance, IntegratorKind,
     IntegratorOptions, TOLERANCE_RANGE,

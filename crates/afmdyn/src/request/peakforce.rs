@@ -198,10 +198,54 @@ impl PeakForceRequest {
             (None, None) => {}
         }
         q.validate()?;
+        self.check_steps(model, &q)?;
         if let Some(sweep) = &self.sweep {
             self.sweep_points(sweep, model, &q)?;
         }
         Ok(q)
+    }
+
+    /// The integrator's steps per modulation period on `p` against its budget
+    /// ([`crate::params::ADAPTIVE_STEPS_BUDGET`]), before any work (issue 77 §7): a refusal
+    /// naming the modulation frequency (`modulation_frequency` in Hz with a probe, `omega`
+    /// without) and the lowest one that fits (the steps scale as the period, 1/f_m), or the
+    /// sample's stiffness where no modulation below the resonance fits.
+    fn check_steps(&self, model: &Resolved, p: &Params) -> Result<(), SimError> {
+        let m = crate::model::CantileverModel::new(p)?;
+        let kind = self.options().integrator.kind.resolve(&m);
+        let budget = crate::params::ADAPTIVE_STEPS_BUDGET;
+        let Some(steps) = crate::integrate::steps_per_period(&m, kind) else {
+            return Ok(());
+        };
+        if steps <= budget {
+            return Ok(());
+        }
+        let (name, f, unit) = match &model.probe {
+            Some(pr) => ("modulation_frequency", pr.drive_frequency, " Hz"),
+            None => ("omega", p.omega, ""),
+        };
+        let f_min = f * steps / budget;
+        // the highest modulation still off resonance, f_m/f₀ = MAX_MODULATION_RATIO
+        let f_max = f * MAX_MODULATION_RATIO * first_natural_frequency(p) / p.omega;
+        let advice = if f_min <= f_max {
+            format!(
+                "give {name} ≥ {}{unit}, or a softer sample",
+                crate::error::number(f_min)
+            )
+        } else {
+            "no modulation below the resonance fits: soften the sample (youngs_modulus) or \
+             its contact"
+                .into()
+        };
+        Err(SimError::out_of_range(
+            name,
+            format!("{}{unit}", crate::error::number(f)),
+            format!(
+                "on this lever and sample the integrator needs about {steps:.2e} steps per \
+                 modulation period, beyond its budget of {budget:e} (the steps grow as f0/f_m \
+                 and with the contact's stiffness): {advice}"
+            ),
+        ))
     }
 }
 
