@@ -3,7 +3,7 @@
 
 The requests (``crates/afmdyn/src/request``) are the one signature of every analysis; their
 JSON Schemas (``docs/schema/requests/*.json``, written by ``AFMDYN_WRITE_SCHEMA=1 cargo
-test --release -p afmdyn --test main schema::``) give each field's
+test --release -p afmdyn --lib integration::schema::``) give each field's
 type, default and description. This script writes ``crates/afmdyn-cli/src/flags.rs``: per
 entry of :data:`STRUCTS` a clap ``Args`` struct with one flag per request field (the field's
 name in kebab-case; its help the field's description; its default the schema's, shown by

@@ -3,7 +3,7 @@
 
 The requests (``crates/afmdyn/src/request``) are the one signature of every analysis: their
 JSON Schemas (``docs/schema/requests/*.json``, written by ``AFMDYN_WRITE_SCHEMA=1 cargo
-test --release -p afmdyn --test main schema::``) give each keyword's
+test --release -p afmdyn --lib integration::schema::``) give each keyword's
 type and default. This script writes, between the markers in
 ``crates/afmdyn-py/python/afmdyn/_afmdyn.pyi``, a ``TypedDict`` per request (its keys, types
 and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the studies run into

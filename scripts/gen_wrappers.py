@@ -10,7 +10,7 @@ request types: field types, ``Default``, doc comments), with the few Python keyw
 own and the widened types listed in :data:`FILES`; the table of variables in "Returns:" of a
 function returning a dataset from the library's result layouts
 (``docs/schema/layouts/<name>.json``, written by
-``cargo test -p afmdyn --test main layouts::``: each variable's name, dims, units and long
+``cargo test -p afmdyn --lib integration::layouts::``: each variable's name, dims, units and long
 name, as the binding builds the dataset from them); its
 summary, the prose of "Returns" and "Raises" come from ``scripts/wrapper_docs.py``. The body hands ``locals()`` to a hand-written finisher
 (``_finish_<name>`` in the module :data:`FILES` names) that runs the request through the one

@@ -48,7 +48,12 @@
 //! * The model and the algorithms — [`params`], [`model`], [`contact`], [`integrate`], [`maps`],
 //!   [`analysis`], [`trajectory`], [`system`], [`tip_sample`], [`beam`], [`galerkin`],
 //!   [`eigen`] and the re-exports below — are public for use as a library (the example above),
-//!   the integration tests, the examples and the benchmarks.
+//!   the examples and the benchmarks.
+//! * The integration tests (`crates/afmdyn/tests/main.rs` and its modules) are compiled inside
+//!   the crate, as the module `integration` of its test build: they reach `pub(crate)` items
+//!   and so do not make an item public. Two stay binaries of their own, outside the crate:
+//!   `tests/allocations.rs` (a counting global allocator) and `tests/toy_law.rs` (a law added as
+//!   an outside user would).
 //! * Everything else is `pub(crate)`: an item is public only when one of those names it or a
 //!   public item's signature shows it.
 //!
@@ -104,3 +109,11 @@ pub use model::CantileverModel;
 pub use params::{Excitation, Hydrodynamic, Params, Structure, SweepParam};
 pub use system::{EventKind, HybridSystem, Region};
 pub use tip_sample::TipSampleSystem;
+
+// the integration tests, inside the crate's test build (see "What is public"): their
+// `afmdyn::` paths name this crate
+#[cfg(test)]
+extern crate self as afmdyn;
+#[cfg(test)]
+#[path = "../tests/main.rs"]
+mod integration;

@@ -16,7 +16,7 @@ fn eigenmodes() -> String {
     common::bimodal_lever("1.88e6", "400, 2507", "1.88e6")
 }
 
-use crate::common;
+use super::common;
 use common::opts;
 
 /// The integrator of the checks: auto (Taylor for DMT) at 1e-12.

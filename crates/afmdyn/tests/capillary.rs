@@ -26,7 +26,7 @@ use afmdyn::{CantileverModel, ContactLaw, HybridSystem, Params, Region};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
-use crate::common;
+use super::common;
 use common::{gauss_legendre, hysteretic_tap};
 
 /// A 40 N/m lever with a 10 nm tip over a polymer in humid air: a 1e-25 m³ water meniscus

@@ -25,7 +25,7 @@ use afmdyn::integrate::{advance, build, Integrator, IntegratorKind, IntegratorOp
 use afmdyn::{CantileverModel, ContactLaw, HybridSystem, LawKind, Params, SimError};
 use nalgebra::{DMatrix, DVector};
 
-use crate::common;
+use super::common;
 use common::laws::{CAP, DMT, ES, JKR, SLS};
 use common::{events_until, harmonic_response};
 

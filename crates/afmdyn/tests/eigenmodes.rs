@@ -11,7 +11,7 @@ use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::stepped::Spacing;
 use afmdyn::eigen::spectrum;
 
-use crate::common;
+use super::common;
 use afmdyn::probe::Probe;
 
 /// The tip, sample and single-frequency drive of the checks.

@@ -8,7 +8,7 @@
 //! periodic attractors (Ω = 3.5 and 5) so that round-off differences decay instead of growing as
 //! they would on the chaotic attractor at Ω = 2.6.
 
-use crate::common;
+use super::common;
 
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation, PropagatorCache};

@@ -22,7 +22,7 @@ use afmdyn::Params;
 use nalgebra::DVector;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::orbit_params::{newton, probe, value_of, with};
 
 /// The adaptive integrator's tolerance of the sensitivities and of the finite differences.

@@ -10,7 +10,7 @@ use afmdyn::contact::ContactLaw;
 use afmdyn::probe::Probe;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::orbit_check::{approach, check_first, Regime};
 use common::orbit_params::probe;
 

@@ -13,7 +13,7 @@ use afmdyn::probe::Probe;
 use afmdyn::request::fit_dynamic::am_probe as am_probe_of;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::am_synthetic::{truth, Normal};
 use common::fm_check::check_fm_jacobian;
 

@@ -16,7 +16,7 @@ use afmdyn::Params;
 use nalgebra::DVector;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::am_synthetic::{
     assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic_of, truth,
 };

@@ -15,7 +15,7 @@ use afmdyn::model::CantileverModel;
 use afmdyn::probe::Probe;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::am_synthetic::{
     am_probe, assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic, synthetic_of,
 };

@@ -26,7 +26,7 @@ use afmdyn::SimError;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use crate::common;
+use super::common;
 use common::am_synthetic::synthetic_with_noise;
 
 /// The 95 % quantile of χ²₁ (the profile's threshold), written out here: 1.959964² = 3.841459.

@@ -13,7 +13,7 @@ use afmdyn::probe::Probe;
 use afmdyn::request::fit_dynamic::am_probe;
 use std::path::Path;
 
-use crate::common;
+use super::common;
 use common::am_synthetic::{
     assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic_of, truth,
 };

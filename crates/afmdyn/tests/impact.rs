@@ -10,7 +10,7 @@ use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, EventKind, HybridSystem, Params};
 use nalgebra::DVector;
 
-use crate::common;
+use super::common;
 use common::{events_until, impact_model, opts};
 
 /// An attractor of the impact law touches the sample: its contacts per period count the

@@ -8,7 +8,7 @@ use afmdyn::integrate::exact::ExactPropagator;
 use afmdyn::integrate::{advance_dyn, build, Integrator, IntegratorKind, IntegratorOptions};
 use afmdyn::trajectory::{record, RecordSpec};
 
-use crate::common;
+use super::common;
 use afmdyn::{CantileverModel, Params, SimError};
 use common::{events_until, harmonic_response};
 use nalgebra::DVector;

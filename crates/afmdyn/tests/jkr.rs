@@ -20,7 +20,7 @@ use afmdyn::{CantileverModel, ContactLaw, Params, Region};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
-use crate::common;
+use super::common;
 use common::{gauss_legendre, hysteretic_tap};
 
 /// A soft lever over a compliant, adhesive polymer: R = 10 nm, E_s = 50 MPa, W = 0.05 J/m².

@@ -19,7 +19,7 @@ use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
-use crate::common;
+use super::common;
 use common::laws::{CAP, DMT, ES, JKR, SLS};
 use common::{events_until, impact_model, opts};
 
@@ -410,7 +410,7 @@ fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64, eps: f64) -
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 6,
-        failure_persistence: crate::common::regressions_beside_the_source(),
+        failure_persistence: super::common::regressions_beside_the_source(),
         ..ProptestConfig::default()
     })]
     /// The Jacobian of the flow over one period (variational equations × saltation matrices)

@@ -2,7 +2,7 @@
 //! markers) is generated from the registry ([`afmdyn::contact::LAWS`]: name, aliases, doc line,
 //! dimensionless groups with symbol, unit, range and default, the probe's `[sample]` keys) and
 //! must equal the committed text, so that the docs cannot drift from the code.
-//! `AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --test main laws_table::` rewrites it.
+//! `AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::laws_table::` rewrites it.
 
 #![cfg(not(feature = "toy-law"))]
 
@@ -73,7 +73,7 @@ fn the_docs_table_of_laws_is_the_registry() {
         assert!(
             text == want,
             "docs/contact-laws.md's table of laws differs from the registry; regenerate with \
-             AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --test main laws_table::"
+             AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::laws_table::"
         );
     }
 }

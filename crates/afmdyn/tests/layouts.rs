@@ -368,7 +368,7 @@ fn layouts_match_the_committed_files() {
     assert!(
         stale.is_empty(),
         "result layouts differ from the code: {stale:?}; regenerate with \
-         AFMDYN_WRITE_SCHEMA=1 cargo test --release -p afmdyn --test main layouts::"
+         AFMDYN_WRITE_SCHEMA=1 cargo test --release -p afmdyn --lib integration::layouts::"
     );
 }
 

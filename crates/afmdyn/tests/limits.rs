@@ -108,7 +108,7 @@ fn magnitude(max: f64) -> impl Strategy<Value = f64> {
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 32,
-        failure_persistence: crate::common::regressions_beside_the_source(),
+        failure_persistence: super::common::regressions_beside_the_source(),
         ..ProptestConfig::default()
     })]
 

@@ -24,7 +24,7 @@ use afmdyn::{CantileverModel, Excitation, IntegratorOptions};
 use nalgebra::{Complex, DVector};
 use std::f64::consts::PI;
 
-use crate::common;
+use super::common;
 use common::{complex_response, harmonic_response};
 
 /// A 240 × 40 × 2.3 µm silicon lever (E = 169 GPa, ρ = 2330 kg/m³: k ≈ 1.5 N/m, 55 kHz in

@@ -1,5 +1,6 @@
-//! The library's integration tests, one binary (crates/afmdyn/Cargo.toml: `autotests = false`):
-//! each tests/*.rs file is a module here, so `cargo test -p afmdyn --test main fm::` runs
+//! The library's integration tests, compiled inside the crate as the module `integration` of
+//! its test build (src/lib.rs; they reach `pub(crate)` items): each tests/*.rs file is a module
+//! here, so `cargo test -p afmdyn --lib integration::fm::` runs
 //! tests/fm.rs. The modules that read probe files need the `files` feature and those that set
 //! rayon's thread count `parallel`. Two files are binaries of their own: tests/allocations.rs
 //! (a counting global allocator, the peak heap over all threads) and tests/toy_law.rs (feature

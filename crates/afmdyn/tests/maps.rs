@@ -23,7 +23,7 @@ use afmdyn::maps::{DiscreteMap, StroboscopicMap};
 use afmdyn::{CantileverModel, Params, SimError};
 use nalgebra::{Complex, DMatrix, DVector};
 
-use crate::common;
+use super::common;
 use common::harmonic_response;
 
 /// z ↦ A z + b: Pⁿ(z) by n images, ∂Pⁿ/∂z = Aⁿ, no events.

@@ -4,7 +4,7 @@
 //! the per-mode energy balance of the beam, and independent checks of THD, mean deflection,
 //! contact fraction and peak force.
 
-use crate::common;
+use super::common;
 
 use afmdyn::analysis::observables::{observe_from, observe_orbit, ObservableOptions, Observables};
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};

@@ -1,7 +1,7 @@
 //! The JSON Schemas of the requests (`docs/schema/requests/<name>.json`) are generated from the
 //! types (`schemars`, feature `schema`) and must equal the committed files, so that the files
 //! cannot drift from the code.
-//! `AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --test main schema::` (re)writes them. Each
+//! `AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::schema::` (re)writes them. Each
 //! schema carries the request's default, serialised, as its one `examples` entry
 //! (crates/afmdyn-py/tests/test_schema.py validates it against the schema); here it must
 //! deserialise back to the default.
@@ -111,7 +111,7 @@ fn request_schemas_match_the_committed_files() {
     assert!(
         stale.is_empty(),
         "request schemas differ from the code: {stale:?}; regenerate with \
-         AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --test main schema::"
+         AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::schema::"
     );
 }
 

@@ -19,7 +19,7 @@ use afmdyn::{CantileverModel, ContactLaw, Params, SimError};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
-use crate::common;
+use super::common;
 use common::events_until;
 
 fn sls(kappa: f64) -> ContactLaw {

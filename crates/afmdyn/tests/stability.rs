@@ -18,7 +18,7 @@ use afmdyn::{CantileverModel, ContactLaw, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
-use crate::common;
+use super::common;
 use common::{events_until, harmonic_response};
 
 fn model(p: Params) -> CantileverModel {
@@ -48,7 +48,7 @@ fn newton(m: &CantileverModel, guess: &DVector<f64>, n: usize) -> PeriodicOrbit 
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 24,
-        failure_persistence: crate::common::regressions_beside_the_source(),
+        failure_persistence: super::common::regressions_beside_the_source(),
         ..ProptestConfig::default()
     })]
 

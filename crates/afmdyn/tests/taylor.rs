@@ -12,7 +12,7 @@ use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, Params};
 
-use crate::common;
+use super::common;
 use common::{against_adaptive_oracle, events_until, harmonic_response};
 
 const DMT: ContactLaw = ContactLaw::Dmt {

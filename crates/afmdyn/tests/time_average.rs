@@ -14,7 +14,7 @@ use afmdyn::probe::{rational_ratio, Probe};
 use afmdyn::request::{run, Analysis, ApproachRequest, CurveRequest, Resolved};
 use afmdyn::CantileverModel;
 
-use crate::common;
+use super::common;
 use common::opts;
 
 /// The eigenmode model of a 40 N/m lever (as `examples/probe-bimodal.toml`) at lower quality

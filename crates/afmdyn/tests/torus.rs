@@ -18,7 +18,7 @@ use afmdyn::probe::Probe;
 use afmdyn::{CantileverModel, Params};
 use nalgebra::DVector;
 
-use crate::common;
+use super::common;
 use common::opts;
 
 /// The eigenmode lever of `common::bimodal_lever` (k = [40, 1571] N/m, f₁ = 300 kHz, Q =

@@ -10,7 +10,7 @@
 //! owners), the model's parameter table, the request schema and a request that sets the group by
 //! name (JSON and a `--config` TOML file), the force law's identities, an orbit (shooting) and
 //! an approach (stepped curve); the conformance suite takes every registered law, so
-//! `cargo test -p afmdyn --features toy-law --test main conformance::` runs its cases on it too.
+//! `cargo test -p afmdyn --features toy-law --lib integration::conformance::` runs its cases on it too.
 //! Python's keywords are the registry's: no hand-written Python file spells a law group (the
 //! generated stubs and type dictionaries aside, which `scripts/gen_stubs.py` writes from the
 //! schema).
