@@ -106,16 +106,6 @@ impl ModeShapes {
         }
     }
 
-    /// Number of modes N.
-    pub fn len(&self) -> usize {
-        self.modes.len()
-    }
-
-    /// Always false (at least one mode).
-    pub fn is_empty(&self) -> bool {
-        self.modes.is_empty()
-    }
-
     /// The modes, index 0 = mode 1.
     pub fn modes(&self) -> &[BeamMode] {
         &self.modes

@@ -110,11 +110,6 @@ impl Galerkin {
         })
     }
 
-    /// The parameters this discretisation was built for.
-    pub fn params(&self) -> &Params {
-        &self.params
-    }
-
     /// Move the sample to the gap α5 = `alpha5` in place: α5 enters only eq. 18's constant
     /// forcing (−α4 α5 φ_i(1)), rewritten by the same formula, so the result equals
     /// [`Galerkin::new`] of the parameters with α5 replaced bit for bit, without allocating.

@@ -31,7 +31,7 @@
 //! values measured in air back to vacuum.
 
 use crate::error::{SimError, UnitsError};
-use crate::units::{positive, preset, Cantilever};
+use crate::units::{positive, Cantilever};
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -72,14 +72,6 @@ impl Medium {
     /// ambient conditions are below 10 kg/m³, liquids above 500).
     pub(crate) fn is_liquid(&self) -> bool {
         self.density >= LIQUID_DENSITY
-    }
-
-    /// A preset by name (`MEDIA`, case-insensitive).
-    ///
-    /// # Errors
-    /// [`UnitsError::Choice`] naming `medium` and listing the presets.
-    pub fn named(name: &str) -> Result<Medium, UnitsError> {
-        preset(&MEDIA, name, "medium", "medium")
     }
 
     /// Check that density and viscosity are finite and positive.

@@ -8,7 +8,8 @@
 
 use afmdyn::analysis::approach::{approach_retract, approach_spec, rest_distance};
 use afmdyn::analysis::continuation::BranchEvent;
-use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
+use afmdyn::analysis::resonance::{mode_band, resonance_spec};
+use afmdyn::analysis::stepped::stepped_sweep;
 use afmdyn::analysis::stepped::{
     grid, is_fixed_point, BranchSample, Reached, Spacing, SteppedCurve, SteppedSpec, Sweep,
 };
@@ -207,7 +208,7 @@ fn far_from_the_sample_the_resonance_curve_is_the_linear_one() {
     let (lo, hi) = mode_band(&base, 1).unwrap();
     let mut spec = resonance_spec(base, lo, hi, Spacing::Points(9)).unwrap();
     spec.branches = false;
-    let c = resonance_curve(&spec).unwrap();
+    let c = stepped_sweep(&spec).unwrap();
     assert!(c.jumps.is_empty());
     for p in c.first.iter().chain(&c.second) {
         let om = p.value;

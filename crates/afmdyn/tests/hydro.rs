@@ -135,8 +135,11 @@ fn lever_in_air_and_in_water() {
 
 #[test]
 fn bad_media_are_refused_naming_the_field() {
-    let e = Medium::named("oil").unwrap_err().to_string();
-    assert!(e.contains("medium"), "{e}");
+    // the probe reader's lookup of `[medium] name`
+    let e = afmdyn::units::preset(&afmdyn::hydro::MEDIA, "oil", "name", "medium")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("medium") && e.contains("water"), "{e}");
     let bad = Medium {
         density: -1.0,
         viscosity: 1e-3,

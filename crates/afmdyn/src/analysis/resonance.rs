@@ -4,7 +4,7 @@
 //! multivalued, bent resonance curves of the intermittent contact (e.g. Lee, Howell & Raman,
 //! *Phys. Rev. B* 66 (2002) 115409) are traced whole. The driver is [`super::stepped`].
 
-use super::stepped::{grid, stepped_sweep, Spacing, SteppedCurve, SteppedSpec};
+use super::stepped::{grid, Spacing, SteppedSpec};
 use crate::eigen::spectrum;
 use crate::error::SimError;
 use crate::params::{Params, SweepParam, OMEGA_MAX, OMEGA_MIN};
@@ -63,13 +63,4 @@ pub fn resonance_spec(
 ) -> Result<SteppedSpec, SimError> {
     let values = grid(from.min(to), from.max(to), spacing)?;
     Ok(SteppedSpec::new(base, SweepParam::Omega, values))
-}
-
-/// Run the up-sweep (the first sweep of the result), the down-sweep (the second) and the
-/// branch continuation of `spec` (from [`resonance_spec`]).
-///
-/// # Errors
-/// As [`stepped_sweep`].
-pub fn resonance_curve(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
-    stepped_sweep(spec)
 }
