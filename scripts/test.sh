@@ -6,7 +6,8 @@
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it, reusing the
 #      library the Rust tests compiled: scripts/check-feature-unification.sh), then
-#      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
+#      pytest crates/afmdyn-py/tests, which also executes the example notebook and script; then
+#      tests/test_toy_law.py against a second wheel built with the toy law (feature toy-law).
 #   3. the WebAssembly engine: bash scripts/test-wasm.sh (crates/afmdyn-wasm built for wasm32,
 #      its JavaScript glue by wasm-bindgen-cli, checked under Node.js against the command line).
 #   4. the explorer in a real browser: bash scripts/test-explorer.sh (the static page built with
@@ -30,8 +31,9 @@ echo "== Rust: cargo test --workspace --release --no-fail-fast"
 cargo test --workspace --release --no-fail-fast 2>&1 | tee "$logs/rust.log"
 rust_code=${PIPESTATUS[0]}
 # the toy contact law (feature toy-law, not shipped): a law is one file plus one registry line
-echo "== Rust: cargo test --release -p afmdyn --features toy-law --test toy_law"
-cargo test --release -p afmdyn --features toy-law --test toy_law 2>&1 | tee -a "$logs/rust.log"
+# (--workspace: the dependencies' features as the toy-law wheel's below, which then reuses the library)
+echo "== Rust: cargo test --release --workspace --features afmdyn/toy-law --test toy_law"
+cargo test --release --workspace --features afmdyn/toy-law --test toy_law 2>&1 | tee -a "$logs/rust.log"
 [ "${PIPESTATUS[0]}" -eq 0 ] || rust_code=1
 rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
 rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
@@ -68,6 +70,30 @@ if [ -x "$py" ]; then
         py_passed=${py_passed:-0}
         if [ "$code" -ne 0 ] && [ "$py_failed" -eq 0 ]; then
             echo "pytest exited with status $code"
+            extra_failed=$((extra_failed + 1))
+        fi
+        # the toy contact law from Python: a second wheel built with the feature toy-law
+        # (reusing the library the Rust toy-law test compiled), installed beside the venv's
+        # packages, not into them; tests/test_toy_law.py runs against it
+        echo "== Python: the toy law (a wheel with feature toy-law, tests/test_toy_law.py)"
+        toy="$logs/toy"
+        if MATURIN_PEP517_ARGS="--features toy-law" "$py" -m pip wheel -q --no-deps -w "$toy/wheel" ./crates/afmdyn-py &&
+            "$py" -m pip install -q --no-deps --target "$toy/site" "$toy"/wheel/*.whl; then
+            AFMDYN_TOY_LAW=1 PYTHONPATH="$toy/site" AFMDYN_BIN="$TARGET/release/afmdyn" \
+                "$py" -m pytest crates/afmdyn-py/tests/test_toy_law.py -p no:cacheprovider 2>&1 | tee "$logs/toy.log"
+            code=${PIPESTATUS[0]}
+            summary=$(grep -E '^=+ .*(passed|failed|error|no tests ran).* in [0-9.]+s' "$logs/toy.log" | tail -1)
+            n=$(echo "$summary" | grep -Eo '[0-9]+ passed' | awk '{print $1}')
+            f=$(echo "$summary" | grep -Eo '[0-9]+ (failed|errors?)' | awk '{s += $1} END {print s + 0}')
+            py_passed=$((py_passed + ${n:-0}))
+            py_failed=$((py_failed + f))
+            if [ "$code" -ne 0 ]; then
+                status=1
+                [ "$f" -gt 0 ] || extra_failed=$((extra_failed + 1))
+            fi
+        else
+            echo "building the toy-law wheel failed"
+            status=1
             extra_failed=$((extra_failed + 1))
         fi
     else
