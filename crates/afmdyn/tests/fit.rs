@@ -309,3 +309,16 @@ fn a_force_curve_fit_needs_only_the_spring_constant_tip_and_sample() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 77 §12: the grazing warning of a dynamic fit says what to do about it (the rows of the
+/// first touch out of `range`, or the profile likelihood's intervals), not only what happened.
+#[test]
+fn the_grazing_warning_of_a_fit_gives_advice() {
+    let w = afmdyn::analysis::fit::sensitivity::SensitivityWarning::Grazing { distance: 1e-9 }
+        .to_string();
+    assert!(w.contains("grazing orbit") && w.contains("`range`"), "{w}");
+    assert!(
+        w.contains("`profiles`") && w.contains("standard errors"),
+        "{w}"
+    );
+}

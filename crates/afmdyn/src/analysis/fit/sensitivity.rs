@@ -166,7 +166,10 @@ impl std::fmt::Display for SensitivityWarning {
             SensitivityWarning::Grazing { distance } => write!(
                 f,
                 "a grazing orbit (distance {distance:.3e} < {GRAZING_TOL:e} g₀): the \
-                 stroboscopic map is not differentiable there"
+                 stroboscopic map is not differentiable there, so the sensitivities of this \
+                 row, and the standard errors drawn from them, are unreliable; leave the rows \
+                 where the tip first touches out of the fit (`range`) or take the intervals \
+                 from the profile likelihood (`profiles`), which needs no derivative"
             ),
         }
     }
