@@ -385,14 +385,14 @@ mod branches;
 #[cfg(feature = "files")]
 mod curve_table;
 mod curves;
-mod present;
+mod documents;
 mod series;
 mod units;
 pub(crate) use branches::*;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
 pub use curves::*;
-pub use present::*;
+pub use documents::*;
 pub use series::*;
 pub use units::*;
 
