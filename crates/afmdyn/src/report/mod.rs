@@ -386,6 +386,7 @@ mod branches;
 mod curve_table;
 mod curves;
 mod documents;
+pub mod present;
 mod series;
 mod units;
 pub(crate) use branches::*;

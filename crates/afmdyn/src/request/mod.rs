@@ -65,6 +65,7 @@ pub mod peakforce;
 pub(crate) mod peakforce_sweep;
 pub(crate) mod pool;
 pub mod present;
+
 pub mod reconstruct;
 pub(crate) mod reconstruct_document;
 pub mod run;

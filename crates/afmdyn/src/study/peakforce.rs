@@ -220,7 +220,7 @@ impl Analysis for PeakForceRequest {
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
         let (files, dir) = (to.files, to.dir);
-        let p = crate::request::present::peakforce::peakforce;
+        let p = crate::report::present::peakforce::peakforce;
         Ok(p(&mut document, units, files, dir))
     }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {

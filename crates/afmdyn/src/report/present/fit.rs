@@ -10,6 +10,39 @@ use crate::report::{OutputsNote, Presentation, TextUnits};
 use serde_json::Value;
 use std::path::Path;
 
+/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
+/// Dataset, those of the channels fitted.
+pub(crate) const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
+    ("z", "m", "piezo position"),
+    ("amplitude", "m", "amplitude, measured"),
+    ("amplitude_fit", "m", "amplitude, fitted"),
+    ("amplitude_residual", "m", "measured − fitted amplitude"),
+    ("phase", "deg", "phase, measured"),
+    ("phase_fit", "deg", "phase, fitted"),
+    ("phase_residual", "deg", "measured − fitted phase"),
+    ("amplitude_2", "m", "second component's amplitude, measured"),
+    (
+        "amplitude_2_fit",
+        "m",
+        "second component's amplitude, fitted",
+    ),
+    (
+        "amplitude_2_residual",
+        "m",
+        "measured − fitted second amplitude",
+    ),
+    ("phase_2", "deg", "second component's phase, measured"),
+    ("phase_2_fit", "deg", "second component's phase, fitted"),
+    ("phase_2_residual", "deg", "measured − fitted second phase"),
+    ("frequency_shift", "Hz", "frequency shift, measured"),
+    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
+    (
+        "frequency_shift_residual",
+        "Hz",
+        "measured − fitted frequency shift",
+    ),
+];
+
 /// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
 pub(crate) const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
 
@@ -173,7 +206,7 @@ pub(crate) fn fit(
 /// The table and figures of a dynamic (AM or FM) fit ([`crate::request::fit_dynamic`]): the columns
 /// of the channels fitted, each channel's data and fit against z, and its residuals.
 fn am_files(p: &mut Presentation, document: &Value, files: Files) {
-    let columns: Vec<&str> = crate::request::fit_result::CURVE_VARIABLES
+    let columns: Vec<&str> = CURVE_VARIABLES
         .iter()
         .map(|v| v.0)
         .filter(|k| document["curve"][k].is_array())

@@ -1,0 +1,70 @@
+//! The presentations of the requests' results ([`crate::report::Presentation`]): per family
+//! of commands, the text summary, the tables, datasets and figures that every front end
+//! writes as they are. Each request's `Analysis::present` calls its function here; a front end
+//! that chooses which files it writes (`--files`, `--dforce-columns`), runs a study into its own
+//! store (`chart`, `image`, the stepped curves, `bifurcation`) or streams a run to files, and
+//! the commands without a computation of their own (`modes --sweep fig3`, `units`,
+//! `cantilevers`) call theirs directly.
+//!
+//! The presentations of the images, the maps (`chart`, `basins`) and the bifurcation sweep
+//! still read request types and stay in `crate::request::present` until those types move.
+
+#[cfg(feature = "files")]
+pub(crate) mod census;
+#[cfg(feature = "files")]
+pub(crate) mod continuation;
+#[cfg(feature = "files")]
+pub(crate) mod converge;
+pub(crate) mod curve_figures;
+pub mod curves;
+pub mod fit;
+pub mod fm;
+pub(crate) mod modes;
+pub(crate) mod orbits;
+pub mod peakforce;
+pub mod reconstruct;
+
+/// Which files a presentation holds (`--files`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Files {
+    /// Data files and figures.
+    #[default]
+    All,
+    /// Data files only (no figures).
+    Data,
+    /// None: only the summary.
+    None,
+}
+
+/// A figure of `series` against one axis, with the data's own extent and nothing shaded.
+pub(crate) fn lines(
+    title: &str,
+    (x_label, y_label): (String, String),
+    series: Vec<crate::layout::figure::Series>,
+) -> crate::layout::figure::Plot {
+    crate::layout::figure::Plot::Lines(crate::layout::figure::Figure {
+        title: title.into(),
+        x_label,
+        y_label,
+        series,
+        shade: Vec::new(),
+        y_min_span: 0.0,
+    })
+}
+
+/// The document as a file `name` of `p`; when the files go to `dir`, the document records
+/// the path of its table `csv` there (`"csv"`, in the document printed too).
+pub(crate) fn with_document(
+    p: &mut crate::report::Presentation,
+    document: &mut serde_json::Value,
+    (name, csv): (&str, &str),
+    dir: Option<&std::path::Path>,
+) {
+    if let Some(dir) = dir {
+        document["csv"] = serde_json::json!(dir.join(csv));
+    }
+    p.files.push(crate::report::OutputFile::Json {
+        name: name.into(),
+        value: document.clone(),
+    });
+}
