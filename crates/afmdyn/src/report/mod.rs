@@ -382,12 +382,15 @@ pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> V
 }
 
 mod branches;
+pub(crate) mod curve_layout;
 #[cfg(feature = "files")]
 mod curve_table;
 mod curves;
 mod documents;
 pub mod present;
 mod series;
+#[cfg(feature = "files")]
+pub(crate) mod simulate_files;
 mod units;
 pub(crate) use branches::*;
 #[cfg(feature = "files")]

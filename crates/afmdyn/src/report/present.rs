@@ -36,6 +36,66 @@ pub enum Files {
     None,
 }
 
+/// Where a front end writes a result (a request's `Analysis::present`): which files, the directory
+/// (none: no files written) and the naming of a stepped curve's columns.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Destination<'a> {
+    /// The files written: all, the data without the figures, or none.
+    pub files: Files,
+    /// The output directory.
+    pub dir: Option<&'a std::path::Path>,
+    /// A stepped curve's CSV/NPY columns named and ordered as dForce 2.0's zcdom table.
+    pub dforce_columns: bool,
+}
+
+impl Destination<'_> {
+    /// A stepped curve's options at this destination, its files named `stem`.
+    pub fn curve(&self, stem: &'static str) -> curves::CurveOptions {
+        curves::CurveOptions {
+            stem,
+            files: self.files,
+            dforce_columns: self.dforce_columns,
+        }
+    }
+    /// `shown` without the files [`Destination::files`] leaves out (the figures, or all).
+    pub fn keep(&self, shown: &mut crate::report::Presentation) {
+        match self.files {
+            Files::All => {}
+            Files::Data => shown
+                .files
+                .retain(|f| !matches!(f, crate::report::OutputFile::Figure { .. })),
+            Files::None => shown.files.clear(),
+        }
+    }
+}
+
+/// A presentation whose output files are named after its whole summary
+/// ([`crate::report::OutputsNote::Tail`]).
+pub(crate) fn tail() -> crate::report::Presentation {
+    crate::report::Presentation {
+        outputs_note: crate::report::OutputsNote::Tail,
+        ..crate::report::Presentation::default()
+    }
+}
+
+/// The table `rows` under `columns` as the CSV file `name` of `p`, each number as the files
+/// write it ([`crate::layout::files::f`]); none without the feature `files`.
+pub(crate) fn numeric_csv(
+    p: &mut crate::report::Presentation,
+    name: &str,
+    columns: &[&str],
+    rows: &[Vec<f64>],
+) {
+    #[cfg(feature = "files")]
+    {
+        use crate::layout::files::f;
+        let text = rows.iter().map(|r| r.iter().map(|v| f(*v)).collect());
+        p.csv(name, columns, text.collect());
+    }
+    #[cfg(not(feature = "files"))]
+    let _ = (p, name, columns, rows);
+}
+
 /// A figure of `series` against one axis, with the data's own extent and nothing shaded.
 pub(crate) fn lines(
     title: &str,

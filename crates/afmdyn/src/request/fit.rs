@@ -627,12 +627,8 @@ impl Analysis for FitRequest {
         _: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        Ok(crate::report::present::fit::fit(
-            &mut document,
-            units,
-            crate::report::present::Files::All,
-            None,
-        ))
+        let to = crate::report::present::Destination::default();
+        Ok(crate::report::present::fit::fit(&mut document, units, to))
     }
 }
 

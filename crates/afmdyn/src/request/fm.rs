@@ -272,8 +272,7 @@ impl Analysis for FmRequest {
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
         let table = table(model, curve);
-        let mut shown =
-            crate::report::present::fm::fm(&mut document, table, units, to.files, to.dir);
+        let mut shown = crate::report::present::fm::fm(&mut document, table, units, to);
         shown.document = Some(document);
         Ok(shown)
     }

@@ -38,7 +38,6 @@ pub mod checkpoint;
 #[cfg(feature = "files")]
 pub(crate) mod checkpoint_file;
 pub(crate) mod costs;
-pub(crate) mod curve_layout;
 pub mod curves;
 mod datasets;
 #[cfg(feature = "files")]
@@ -70,8 +69,6 @@ pub mod reconstruct;
 pub(crate) mod reconstruct_document;
 pub mod run;
 pub mod simulate;
-#[cfg(feature = "files")]
-pub(crate) mod simulate_files;
 #[cfg(feature = "files")]
 pub mod simulate_stream;
 pub mod sweep;

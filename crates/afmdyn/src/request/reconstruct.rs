@@ -362,8 +362,7 @@ fn present_reconstruction(
     to: super::run::Destination<'_>,
 ) -> Result<crate::report::Presentation, SimError> {
     let mut document = document.clone();
-    let files = (to.files, to.dir);
-    let mut shown = reconstruction(r, how, law, &mut document, units, files);
+    let mut shown = reconstruction(r, how, law, &mut document, units, to);
     shown.document = Some(document);
     Ok(shown)
 }

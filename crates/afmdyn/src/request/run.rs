@@ -158,39 +158,7 @@ pub trait Analysis {
     }
 }
 
-/// Where a front end writes a result ([`Analysis::present`]): which files, the directory
-/// (none: no files written) and the naming of a stepped curve's columns.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Destination<'a> {
-    /// The files written: all, the data without the figures, or none.
-    pub files: crate::report::present::Files,
-    /// The output directory.
-    pub dir: Option<&'a std::path::Path>,
-    /// A stepped curve's CSV/NPY columns named and ordered as dForce 2.0's zcdom table.
-    pub dforce_columns: bool,
-}
-
-impl Destination<'_> {
-    /// A stepped curve's options at this destination, its files named `stem`.
-    pub fn curve(&self, stem: &'static str) -> crate::report::present::curves::CurveOptions {
-        crate::report::present::curves::CurveOptions {
-            stem,
-            files: self.files,
-            dforce_columns: self.dforce_columns,
-        }
-    }
-    /// `shown` without the files [`Destination::files`] leaves out (the figures, or all).
-    pub fn keep(&self, shown: &mut report::Presentation) {
-        use crate::report::present::Files;
-        match self.files {
-            Files::All => {}
-            Files::Data => shown
-                .files
-                .retain(|f| !matches!(f, report::OutputFile::Figure { .. })),
-            Files::None => shown.files.clear(),
-        }
-    }
-}
+pub use crate::report::present::Destination;
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the

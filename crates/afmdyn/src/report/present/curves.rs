@@ -127,7 +127,6 @@ fn present(s: &Shown<'_>, params: &Params, document: &Value, o: &CurveOptions) -
 /// dForce's `zcdom` columns first with `dforce`).
 #[cfg(feature = "files")]
 fn table(p: &mut Presentation, s: &Shown<'_>, params: &Params, dforce: bool) {
-    use crate::layout::files::f;
     use crate::report::{curve_table, CurveAxis};
     let axis = CurveAxis {
         name: s.l.x_name,
@@ -136,11 +135,7 @@ fn table(p: &mut Presentation, s: &Shown<'_>, params: &Params, dforce: bool) {
     };
     let (rows, columns) = curve_table(s.c, s.x, s.u, params, &axis, dforce);
     let header: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
-    let text = rows
-        .iter()
-        .map(|r| r.iter().map(|v| f(*v)).collect())
-        .collect();
-    p.csv(&format!("{}.csv", s.l.stem), &header, text);
+    super::numeric_csv(p, &format!("{}.csv", s.l.stem), &header, &rows);
     p.files.push(crate::report::OutputFile::Npy {
         name: format!("{}.npy", s.l.stem),
         columns,

@@ -4,11 +4,10 @@
 //! beside the data (against time too, for `sls`) and of the residuals.
 
 use super::peakforce::rows;
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
 use crate::layout::figure::{Series, Style};
-use crate::report::{OutputsNote, Presentation, TextUnits};
+use crate::report::{Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
@@ -89,16 +88,8 @@ fn held_line(document: &Value, text: TextUnits) -> Option<String> {
 
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
-pub(crate) fn fit(
-    document: &mut Value,
-    text: TextUnits,
-    files: Files,
-    dir: Option<&Path>,
-) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+pub(crate) fn fit(document: &mut Value, text: TextUnits, to: Destination<'_>) -> Presentation {
+    let mut p = tail();
     let units = document["units"].clone();
     if let Some(est) = document["estimates"].as_object() {
         for (name, e) in est {
@@ -127,12 +118,12 @@ pub(crate) fn fit(
         document["chi2_dof"].as_f64().unwrap_or(f64::NAN),
         document["noise"].as_str().unwrap_or(""),
     ));
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
     if dynamic.is_some() {
-        am_files(&mut p, document, files);
-        with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+        am_files(&mut p, document, to.files);
+        with_document(&mut p, document, ("fit.json", "fit-curve.csv"), to.dir);
         return p;
     }
     // a time-dependent law's curve (sls) carries the rows' times: a column and a figure more
@@ -142,16 +133,8 @@ pub(crate) fn fit(
         columns.push("time");
     }
     let curve = rows(document, "curve", &columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = curve
-            .iter()
-            .map(|r| r.iter().map(|v| f(*v)).collect())
-            .collect();
-        p.csv("fit-curve.csv", &columns, table);
-    }
-    if files == Files::All {
+    numeric_csv(&mut p, "fit-curve.csv", &columns, &curve);
+    if to.files == Files::All {
         let against = |x: usize, label: &str, col: usize, style: Style, color: usize| Series {
             label: label.into(),
             points: curve
@@ -199,7 +182,7 @@ pub(crate) fn fit(
             );
         }
     }
-    with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+    with_document(&mut p, document, ("fit.json", "fit-curve.csv"), to.dir);
     p
 }
 
@@ -212,15 +195,7 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
         .filter(|k| document["curve"][k].is_array())
         .collect();
     let curve = rows(document, "curve", &columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = curve
-            .iter()
-            .map(|r| r.iter().map(|v| f(*v)).collect())
-            .collect();
-        p.csv("fit-curve.csv", &columns, table);
-    }
+    numeric_csv(p, "fit-curve.csv", &columns, &curve);
     if files != Files::All {
         return;
     }

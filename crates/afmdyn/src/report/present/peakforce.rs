@@ -3,14 +3,13 @@
 //! `peakforce-curve.csv`, its document `peakforce.json` and the figures of force against
 //! distance and against time.
 
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
 use crate::analysis::peakforce::SteadyTap;
 use crate::layout::columns::{self, columns, Column};
 use crate::layout::figure::{Series, Style};
 use crate::params::Params;
-use crate::report::{CurveUnits, OutputsNote, Presentation, TextUnits};
+use crate::report::{CurveUnits, Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
 
 /// What a sweep's columns ([`COLUMNS`]) are read through: the document's units and the factor
 /// from the fitted Hertz group to the reported modulus (the reduced modulus in Pa with a probe
@@ -144,16 +143,12 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
 pub(crate) fn peakforce(
     document: &mut Value,
     text: TextUnits,
-    files: Files,
-    dir: Option<&Path>,
+    to: Destination<'_>,
 ) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+    let mut p = tail();
     let sweep = sweep_table(document);
     summary(&mut p, document, text, sweep.as_ref());
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
     let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
@@ -168,21 +163,12 @@ pub(crate) fn peakforce(
         CURVE_COLUMNS.to_vec()
     };
     let curve = rows(document, "curve", &curve_columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = |t: &[Vec<f64>]| {
-            t.iter()
-                .map(|r| r.iter().map(|v| f(*v)).collect())
-                .collect()
-        };
-        p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
-        p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
-        if let Some((_, rows, columns)) = &sweep {
-            p.csv("peakforce-sweep.csv", columns, table(rows));
-        }
+    numeric_csv(&mut p, "peakforce-cycle.csv", &CYCLE_COLUMNS, &cycle);
+    numeric_csv(&mut p, "peakforce-curve.csv", &curve_columns, &curve);
+    if let Some((_, rows, columns)) = &sweep {
+        numeric_csv(&mut p, "peakforce-sweep.csv", columns, rows);
     }
-    if files == Files::All {
+    if to.files == Files::All {
         figures(
             &mut p,
             document,
@@ -195,7 +181,7 @@ pub(crate) fn peakforce(
         &mut p,
         document,
         ("peakforce.json", "peakforce-cycle.csv"),
-        dir,
+        to.dir,
     );
     p
 }
