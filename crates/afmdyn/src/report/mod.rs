@@ -391,6 +391,7 @@ pub mod present;
 mod series;
 #[cfg(feature = "files")]
 pub(crate) mod simulate_files;
+pub(crate) mod sweep;
 mod units;
 pub(crate) use branches::*;
 #[cfg(feature = "files")]

@@ -23,6 +23,7 @@ pub(crate) mod modes;
 pub(crate) mod orbits;
 pub mod peakforce;
 pub mod reconstruct;
+pub(crate) mod sweeps;
 
 /// Which files a presentation holds (`--files`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

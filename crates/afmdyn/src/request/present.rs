@@ -4,4 +4,3 @@
 
 pub mod image;
 pub(crate) mod maps;
-pub(crate) mod sweeps;
