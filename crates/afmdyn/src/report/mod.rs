@@ -381,6 +381,7 @@ pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> V
         .collect()
 }
 
+pub(crate) mod basins;
 mod branches;
 pub(crate) mod curve_layout;
 #[cfg(feature = "files")]

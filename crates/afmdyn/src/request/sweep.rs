@@ -1,5 +1,6 @@
 //! The fingerprint of a bifurcation request that a resumed sweep must match, and the first
-//! field in which two differ; the sweep's records are [`crate::report::sweep`]'s.
+//! field in which two differ; the sweep's records are `crate::report::sweep`'s (re-exported
+//! here).
 
 pub use crate::report::sweep::*;
 

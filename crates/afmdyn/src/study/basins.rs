@@ -16,7 +16,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
-use crate::request::basins::document;
+use crate::report::basins::document;
 use crate::request::costs::{basins_cost, check_cost};
 use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
