@@ -383,6 +383,7 @@ pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> V
 
 pub(crate) mod basins;
 mod branches;
+pub(crate) mod chart_layout;
 pub(crate) mod curve_layout;
 #[cfg(feature = "files")]
 mod curve_table;

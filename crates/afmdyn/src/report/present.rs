@@ -19,6 +19,7 @@ pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fit;
 pub mod fm;
+pub(crate) mod maps;
 pub(crate) mod modes;
 pub(crate) mod orbits;
 pub mod peakforce;

@@ -33,7 +33,6 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
-pub(crate) mod chart_layout;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub(crate) mod checkpoint_file;
