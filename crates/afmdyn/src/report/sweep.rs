@@ -9,9 +9,9 @@
 //! The command line writes them as `bifurcation.csv` (`SweepRecord::csv_line`, `HEADER`);
 //! Python returns them as columns.
 
-use crate::analysis::bifurcation::{Branch, SweepPoint};
 #[cfg(feature = "files")]
 use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::bifurcation::{Branch, SweepPoint};
 #[cfg(feature = "files")]
 use crate::layout::{Layout, Values, Variable};
 use crate::params::SweepParam;
