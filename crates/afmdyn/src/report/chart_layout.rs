@@ -7,13 +7,13 @@ use crate::layout::{Layout, Variable};
 
 /// A chart axis as its files name it: the parameter's name, its symbol and its unit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ChartAxis<'a> {
+pub(crate) struct ChartAxis<'a> {
     /// The parameter's name (`omega`, `free_amplitude`).
-    pub name: &'a str,
+    pub(crate) name: &'a str,
     /// Its symbol (`Ω`; the name where it has none).
-    pub symbol: &'a str,
+    pub(crate) symbol: &'a str,
     /// Its unit (`"1"` dimensionless).
-    pub unit: &'a str,
+    pub(crate) unit: &'a str,
 }
 
 /// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
