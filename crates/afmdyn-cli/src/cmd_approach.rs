@@ -2,14 +2,14 @@
 //! `afmdyn resonance` (amplitude and phase against the drive frequency): stepped sweeps both
 //! ways plus branch continuation ([`afmdyn::analysis::stepped`]), run as resumable studies
 //! into the `--out` directory's store ([`CurveStudy`]); their summary, tables, traces and
-//! figures are the library's ([`afmdyn::request::present::curves`]).
+//! figures are the library's ([`afmdyn::report::present::curves`]).
 
 use crate::args::ModelArgs;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit, Resume};
 use crate::error::CliError;
 use crate::flags::{ApproachFlags, BimodalFlags, ResonanceFlags};
-use afmdyn::request::present;
+use afmdyn::report::present;
 use afmdyn::request::Bimodal;
 use afmdyn::request::Params;
 use afmdyn::request::SteppedCurve;

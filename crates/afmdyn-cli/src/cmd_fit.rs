@@ -5,7 +5,7 @@
 //! warnings (with `--profiles`, an AM curve's intervals are the profile likelihood's too).
 //! The request, the preprocessing, the fit and the document are the library's
 //! ([`afmdyn::request::FitRequest`], [`afmdyn::analysis::fit`]), and so are its summary, table,
-//! figures and `fit.json` ([`afmdyn::request::present::fit`]); this front end maps the flags.
+//! figures and `fit.json` ([`afmdyn::report::present::fit`]); this front end maps the flags.
 
 use crate::args::ModelArgs;
 use crate::cmd_approach::files;

@@ -3,7 +3,7 @@
 //! controller sets, as exact periodic orbits. The request, the analysis and the document are
 //! the library's ([`afmdyn::request::FmRequest`], [`afmdyn::analysis::fm`]), and so are its
 //! summary, `fm.csv`, `fm.json` and the frequency-shift figure
-//! ([`afmdyn::request::present::fm`]); this front end maps the flags.
+//! ([`afmdyn::report::present::fm`]); this front end maps the flags.
 
 use crate::args::ModelArgs;
 use crate::cmd_approach::files;

@@ -3,7 +3,7 @@
 //! a setpoint, with the instrument's channels, one cycle and the force–distance curve. The
 //! request, the analysis and the document are the library's
 //! ([`afmdyn::request::PeakForceRequest`], [`afmdyn::analysis::peakforce`]), and so are its
-//! summary, tables, figures and `peakforce.json` ([`afmdyn::request::present::peakforce`]);
+//! summary, tables, figures and `peakforce.json` ([`afmdyn::report::present::peakforce`]);
 //! this front end maps the flags.
 
 use crate::args::{Dim, ModelArgs, Quantity};

@@ -3,7 +3,7 @@
 //! library's ([`afmdyn::request::ReconstructRequest`], [`afmdyn::analysis::reconstruct`]),
 //! and so are the reading of the curve file ([`afmdyn::io::curve_file`]), the summary,
 //! `reconstruct.csv`, the force figure and the JSON document
-//! ([`afmdyn::request::present::reconstruct`]); this front end maps the flags.
+//! ([`afmdyn::report::present::reconstruct`]); this front end maps the flags.
 
 use crate::args::{named, quantity, Dim};
 use crate::cmd_approach::files;

@@ -42,6 +42,10 @@ pub struct AttractorSpec {
 /// Largest number of random initial states of a census (each is a steady-state search kept in
 /// memory with its Poincaré points).
 pub const MAX_ATTRACTOR_SAMPLES: usize = 100_000;
+/// Samples per drive period at which attractors are recorded (their plots and files); the
+/// integrator of the census is built for this rate, so the same request gives the same
+/// attractors in every front end.
+pub(crate) const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
 
 impl AttractorSpec {
     /// Check the census's options (the one place of their limits).

@@ -381,18 +381,25 @@ pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> V
         .collect()
 }
 
+pub(crate) mod basins;
 mod branches;
+pub(crate) mod chart_layout;
+pub(crate) mod curve_layout;
 #[cfg(feature = "files")]
 mod curve_table;
 mod curves;
-mod present;
+mod documents;
+pub mod present;
 mod series;
+#[cfg(feature = "files")]
+pub(crate) mod simulate_files;
+pub(crate) mod sweep;
 mod units;
 pub(crate) use branches::*;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
 pub use curves::*;
-pub use present::*;
+pub use documents::*;
 pub use series::*;
 pub use units::*;
 

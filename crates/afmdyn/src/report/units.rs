@@ -49,6 +49,11 @@ impl CurveUnits {
         }
     }
 
+    /// [`CurveUnits::from_scales`] of a probe's scales, the model's own units without one.
+    pub(crate) fn of(probe: Option<&crate::probe::Probe>, hz: bool) -> Self {
+        probe.map_or_else(Self::dimensionless, |p| Self::from_scales(&p.scales, hz))
+    }
+
     /// The name of the unit of `kind` (the document's `units` block).
     pub fn unit(&self, kind: UnitKind) -> &'static str {
         match (kind, self.si) {
@@ -109,9 +114,7 @@ impl SeriesUnits {
     /// The units of `params`' trajectories, SI when `probe` is given.
     pub fn new(params: &Params, probe: Option<&crate::probe::Probe>) -> Self {
         SeriesUnits {
-            u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
-                CurveUnits::from_scales(&pr.scales, true)
-            }),
+            u: CurveUnits::of(probe, true),
             point_mass: params.structure.is_lumped(),
         }
     }

@@ -7,8 +7,9 @@
 //! resolve through [`ModelSpec::resolve`] like a single run's. The chart's cells and tasks are
 //! [`crate::analysis::chart`]'s; this module holds the request, its limits, its fingerprint
 //! (what a resumed chart must match); the one layout of its results is
-//! `super::chart_layout`'s ([`ChartArrays`], the variables of `chart.nc` and of Python's
-//! `xarray.Dataset`; [`CSV_HEADER`], the rows of `chart.csv`).
+//! `crate::report::chart_layout`'s ([`ChartArrays`], the variables of `chart.nc` and of
+//! Python's `xarray.Dataset`; [`CSV_HEADER`], the rows of `chart.csv`), read here through the
+//! chart's axes and length unit.
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
 use super::model::{parameter, ModelSpec, ValueKind};
@@ -20,7 +21,9 @@ use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-pub use super::chart_layout::{csv_lines, ChartArrays, CSV_HEADER};
+use crate::layout::Layout;
+use crate::report::chart_layout::ChartAxis;
+pub use crate::report::chart_layout::{ChartArrays, CSV_HEADER};
 
 /// Largest number of cells of a chart (x_steps × y_steps).
 pub(crate) const MAX_CHART_CELLS: usize = 1_000_000;
@@ -474,6 +477,64 @@ pub(crate) fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
 /// The unit of a chart axis, for labels and the files' `units` attributes.
 pub fn axis_unit(name: &str) -> &'static str {
     probe_axis(name).map_or_else(|| parameter(name).map_or("1", |p| p.unit), |a| a.3)
+}
+
+/// The axis `name` as the chart's files show it: its symbol in [`super::MODEL_PARAMETERS`]
+/// and its unit ([`axis_unit`]).
+pub(crate) fn axis(name: &str) -> ChartAxis<'_> {
+    let symbol = parameter(name).map_or(name, |p| p.symbol);
+    ChartAxis {
+        name,
+        symbol,
+        unit: axis_unit(name),
+    }
+}
+
+/// The rows of `cell` of `chart` as CSV lines of [`CSV_HEADER`], lengths in g₀ or, with a
+/// probe, in m ([`ChartModel::length_m`] of the cell).
+pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
+    let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
+    crate::report::chart_layout::csv_lines(length, cell)
+}
+
+impl ChartArrays {
+    /// The chart's layout over its axes named `x_name` and `y_name`: coordinates `x` and `y`
+    /// in their axes' units, per cell (y, x) `attractors`, `failures`, `dominant_period`, and
+    /// per attractor slot (y, x, attractor) `period`, `motion`, `lyapunov`, `lyapunov_error`,
+    /// `x_max`, `v_t_min`, `contacts_per_period`, `contact_fraction`, `fraction`.
+    pub fn layout(&self, x_name: &str, y_name: &str) -> Layout {
+        self.layout_over(axis(x_name), axis(y_name))
+    }
+
+    /// The arrays of `cells` (any order; each cell once) of the whole chart.
+    pub fn new(chart: &Chart, cells: &[ChartCell]) -> ChartArrays {
+        let size = (chart.spec.x.len(), chart.spec.y.len());
+        ChartArrays::region(chart, (0, 0), size, cells)
+    }
+
+    /// The arrays of the region of `size` = (columns, rows) from the cell `origin` = (ix, iy)
+    /// of the chart: a task's tile is the region ((lo, iy), (hi − lo, 1)); cells outside it are
+    /// left out.
+    pub fn region(
+        chart: &Chart,
+        origin: (usize, usize),
+        size: (usize, usize),
+        cells: &[ChartCell],
+    ) -> ChartArrays {
+        ChartArrays::region_of((&chart.spec, chart.slots), origin, size, cells)
+    }
+}
+
+impl Chart {
+    /// The chart as its presentation reads it ([`crate::report::present::maps::ChartView`]).
+    pub(crate) fn view(&self) -> crate::report::present::maps::ChartView<'_> {
+        crate::report::present::maps::ChartView {
+            spec: &self.spec,
+            slots: self.slots,
+            axes: (axis(self.model.x), axis(self.model.y)),
+            length: Box::new(|x, y| self.model.length_m(x, y).unwrap_or(1.0)),
+        }
+    }
 }
 
 /// The caveats of a chart's answer (the `warnings` of its document): attractors that did not

@@ -176,6 +176,30 @@ pub(crate) fn each_row<E: From<CheckpointError>>(
     Ok(())
 }
 
+/// A bifurcation diagram's points read from its store's CSV, chunk by chunk.
+impl crate::layout::figure::PointSource for crate::report::present::sweeps::StoredDiagram {
+    fn feed(
+        &self,
+        draw: &mut crate::layout::figure::PointSink<'_>,
+    ) -> Result<(), crate::layout::figure::FeedError> {
+        use crate::layout::figure::FeedError;
+        let mut chunk = Vec::with_capacity(4096);
+        each_row(&self.csv, &mut |r| -> Result<(), FeedError> {
+            chunk.extend(crate::report::present::sweeps::diagram_point(
+                crate::report::present::sweeps::SweepRow::from_csv(r),
+                self.column,
+                self.by_branch,
+            ));
+            if chunk.len() == chunk.capacity() {
+                draw(&chunk).map_err(FeedError::Io)?;
+                chunk.clear();
+            }
+            Ok(())
+        })?;
+        draw(&chunk).map_err(FeedError::Io)
+    }
+}
+
 /// A store's error feeding a figure: a store not as written, or past its cap, is refused (bad
 /// input); any other is a read failure.
 impl From<CheckpointError> for crate::layout::figure::FeedError {

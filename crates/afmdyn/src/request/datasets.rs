@@ -130,11 +130,12 @@ impl Datasets for LyapunovRequest {
 }
 
 impl Datasets for ObserveRequest {
-    /// The observables' layout from the document (`super::curve_layout::observe_layout`)
+    /// The observables' layout from the document (`crate::report::curve_layout::observe_layout`)
     /// and the period.
     fn datasets(&self, model: &Resolved, o: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, o)?;
-        let layout = super::curve_layout::observe_layout(&doc, o.state.as_slice(), o.period);
+        let layout =
+            crate::report::curve_layout::observe_layout(&doc, o.state.as_slice(), o.period);
         Ok((
             vec![("observe".into(), layout)],
             facts(json!({ "period": o.period })),
@@ -318,18 +319,18 @@ impl Datasets for GlobalContinuationRequest {
 }
 
 impl Datasets for ApproachRequest {
-    /// The curve's layout from its document (`super::curve_layout::curve_layout`).
+    /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, curve)?;
-        one("curve", super::curve_layout::curve_layout(&doc))
+        one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }
 
 impl Datasets for ResonanceRequest {
-    /// The curve's layout from its document (`super::curve_layout::curve_layout`).
+    /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
         let doc = super::run::document(self, model, curve)?;
-        one("curve", super::curve_layout::curve_layout(&doc))
+        one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }
 

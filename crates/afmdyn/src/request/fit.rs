@@ -627,12 +627,8 @@ impl Analysis for FitRequest {
         _: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        Ok(super::present::fit::fit(
-            &mut document,
-            units,
-            super::present::Files::All,
-            None,
-        ))
+        let to = crate::report::present::Destination::default();
+        Ok(crate::report::present::fit::fit(&mut document, units, to))
     }
 }
 
@@ -763,7 +759,7 @@ impl super::named::Datasets for FitRequest {
         };
         let n = r.rows.len();
         let columns: &[(&str, &str, &str)] = if r.dynamic.is_some() {
-            &super::fit_result::CURVE_VARIABLES
+            &crate::report::present::fit::CURVE_VARIABLES
         } else {
             &[
                 ("tip_position", "m", "tip position"),

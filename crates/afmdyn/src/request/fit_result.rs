@@ -8,39 +8,6 @@ use crate::contact::LawKind;
 use crate::error::SimError;
 use crate::probe::ranges::si_range;
 
-/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
-/// Dataset, those of the channels fitted.
-pub(crate) const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
-    ("z", "m", "piezo position"),
-    ("amplitude", "m", "amplitude, measured"),
-    ("amplitude_fit", "m", "amplitude, fitted"),
-    ("amplitude_residual", "m", "measured − fitted amplitude"),
-    ("phase", "deg", "phase, measured"),
-    ("phase_fit", "deg", "phase, fitted"),
-    ("phase_residual", "deg", "measured − fitted phase"),
-    ("amplitude_2", "m", "second component's amplitude, measured"),
-    (
-        "amplitude_2_fit",
-        "m",
-        "second component's amplitude, fitted",
-    ),
-    (
-        "amplitude_2_residual",
-        "m",
-        "measured − fitted second amplitude",
-    ),
-    ("phase_2", "deg", "second component's phase, measured"),
-    ("phase_2_fit", "deg", "second component's phase, fitted"),
-    ("phase_2_residual", "deg", "measured − fitted second phase"),
-    ("frequency_shift", "Hz", "frequency shift, measured"),
-    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
-    (
-        "frequency_shift_residual",
-        "Hz",
-        "measured − fitted frequency shift",
-    ),
-];
-
 /// How a fit's intervals were found, for its document's `method`: the profile likelihood's
 /// where any parameter was profiled, else the Wald intervals.
 pub(crate) fn intervals_method(o: &FitOutcome) -> &'static str {

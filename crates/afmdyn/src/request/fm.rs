@@ -142,10 +142,7 @@ pub fn default_from(base: &crate::Params, a: f64, to: f64) -> Option<f64> {
 impl FmRequest {
     /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
     pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        match &model.probe {
-            Some(p) => CurveUnits::from_scales(&p.scales, true),
-            None => CurveUnits::dimensionless(),
-        }
+        CurveUnits::of(model.probe.as_ref(), true)
     }
 
     /// The analysis' spec on `model`: the z_c grid (α5 values, from the far end), the amplitude
@@ -275,7 +272,7 @@ impl Analysis for FmRequest {
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
         let table = table(model, curve);
-        let mut shown = super::present::fm::fm(&mut document, table, units, to.files, to.dir);
+        let mut shown = crate::report::present::fm::fm(&mut document, table, units, to);
         shown.document = Some(document);
         Ok(shown)
     }

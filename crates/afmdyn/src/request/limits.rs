@@ -25,12 +25,9 @@ pub use crate::io::input::{MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};
 pub const TOLERANCE_RANGE: (f64, f64) = crate::integrate::TOLERANCE_RANGE;
 /// Largest number of samples per drive period of a time series.
 pub const MAX_SAMPLES_PER_PERIOD: usize = 100_000;
+pub(crate) use crate::analysis::attractors::ATTRACTOR_SAMPLES_PER_PERIOD;
 pub use crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES;
 pub use crate::analysis::steady::MAX_STEADY_PERIODS;
-/// Samples per drive period at which attractors are recorded (their plots and files); the
-/// integrator of the census is built for this rate, so the same request gives the same
-/// attractors in every front end.
-pub(crate) const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
 /// Largest number of worker threads a sweep may ask for.
 pub const MAX_THREADS: usize = 1024;
 // the bound as `check_threads`'s message spells it

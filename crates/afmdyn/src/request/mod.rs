@@ -33,12 +33,10 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
-pub(crate) mod chart_layout;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub(crate) mod checkpoint_file;
 pub(crate) mod costs;
-pub(crate) mod curve_layout;
 pub mod curves;
 mod datasets;
 #[cfg(feature = "files")]
@@ -65,12 +63,11 @@ pub mod peakforce;
 pub(crate) mod peakforce_sweep;
 pub(crate) mod pool;
 pub mod present;
+
 pub mod reconstruct;
 pub(crate) mod reconstruct_document;
 pub mod run;
 pub mod simulate;
-#[cfg(feature = "files")]
-pub(crate) mod simulate_files;
 #[cfg(feature = "files")]
 pub mod simulate_stream;
 pub mod sweep;

@@ -53,7 +53,7 @@ impl Analysis for ModesRequest {
         units: report::TextUnits,
         _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::modes::modes(
+        Ok(crate::report::present::modes::modes(
             &model.params,
             free,
             contact,
@@ -63,8 +63,8 @@ impl Analysis for ModesRequest {
 }
 
 /// `modes --sweep fig3`: the paper's Fig. 3 maps, ω₁/ω₀₁ and ω₂/ω₀₂ of the contact system
-/// over the α1 × α4 grid (`super::present::modes::fig3_alpha1` ×
-/// `super::present::modes::fig3_alpha4`) at the model's N ([`crate::eigen::fig3_sweep`]).
+/// over the α1 × α4 grid (`crate::report::present::modes::fig3_alpha1` ×
+/// `crate::report::present::modes::fig3_alpha4`) at the model's N ([`crate::eigen::fig3_sweep`]).
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Fig3Request {
@@ -79,8 +79,8 @@ impl Analysis for Fig3Request {
     }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         let (alpha1, alpha4) = (
-            super::present::modes::fig3_alpha1(),
-            super::present::modes::fig3_alpha4(),
+            crate::report::present::modes::fig3_alpha1(),
+            crate::report::present::modes::fig3_alpha4(),
         );
         Ok(fig3_sweep(model.params.modes, &alpha1, &alpha4)?)
     }
@@ -103,7 +103,7 @@ impl Analysis for Fig3Request {
         _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         #[cfg(feature = "files")]
-        let mut shown = super::present::modes::fig3(model.params.modes, points);
+        let mut shown = crate::report::present::modes::fig3(model.params.modes, points);
         #[cfg(not(feature = "files"))]
         let mut shown = report::Presentation::default();
         let _ = model;
@@ -163,7 +163,7 @@ impl Analysis for UnitsRequest {
         _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(match (&self.physical, output) {
-            (Some(m), Some((p, s))) => super::present::modes::units(m, p, s),
+            (Some(m), Some((p, s))) => crate::report::present::modes::units(m, p, s),
             _ => {
                 let mut shown = report::Presentation::default();
                 shown.line(serde_json::to_string_pretty(document).expect("a document serialises"));
@@ -203,6 +203,6 @@ impl Analysis for CantileversRequest {
         _: report::TextUnits,
         _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::modes::cantilevers())
+        Ok(crate::report::present::modes::cantilevers())
     }
 }

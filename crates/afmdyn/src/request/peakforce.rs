@@ -102,10 +102,7 @@ pub struct PeakForceResult {
 impl PeakForceRequest {
     /// The units of the document: SI with a probe, else the model's.
     pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        match &model.probe {
-            Some(p) => CurveUnits::from_scales(&p.scales, true),
-            None => CurveUnits::dimensionless(),
-        }
+        CurveUnits::of(model.probe.as_ref(), true)
     }
 
     /// The analysis' options.

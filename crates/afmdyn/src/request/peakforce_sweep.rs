@@ -5,10 +5,9 @@
 
 use crate::analysis::peakforce::SteadyTap;
 use crate::error::SimError;
-use crate::layout::columns::{self, columns, Column, UnitNames};
+use crate::layout::columns::{self, UnitNames};
 use crate::layout::{Layout, Values, Variable};
-use crate::params::Params;
-use crate::report::CurveUnits;
+pub(crate) use crate::report::present::peakforce::{Frame, SweepTap, COLUMNS};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::str::FromStr;
@@ -104,48 +103,6 @@ impl PeakForceSweep {
         let dir = if to >= from { step } else { -step };
         Ok((0..=n as usize).map(|k| from + dir * k as f64).collect())
     }
-}
-
-/// What a sweep's columns ([`COLUMNS`]) are read through: the document's units and the factor
-/// from the fitted Hertz group to the reported modulus (the reduced modulus in Pa with a probe
-/// and a law with a tip radius, else 1).
-pub(crate) struct Frame {
-    /// The document's units.
-    pub u: CurveUnits,
-    /// Reported modulus per unit of the Hertz group.
-    pub modulus_scale: f64,
-}
-
-/// The channels of a sweep, one entry per value (missing where the point failed): the
-/// document's `sweep.channels` and `sweep.units`, the layout's variables and the columns of the
-/// table `peakforce-sweep.csv` after the swept value, in this order (the layout lists
-/// `modulus_dmt` last, [`sweep_layout`]).
-const COLUMNS: [Column<Frame, SweepTap>; 10] = columns! {
-    "peak_force", Force, true, "peak force",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.peak_force * f.u.force));
-    "adhesion", Force, true, "adhesion (most negative force)",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.adhesion * f.u.force));
-    "deformation", Length, true, "largest indentation",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.deformation * f.u.length));
-    "dissipation", Energy, true, "tip-sample work per cycle",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.dissipation * f.u.energy));
-    "contact_time", Own("s", "τ"), true, "time in contact per cycle",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.contact_time * f.u.time));
-    "snap_off_time", Own("s", "τ"), true, "snap-off from the largest separation",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.snap_off_time * f.u.time));
-    "ringing_amplitude", Length, true, "ringing after snap-off",
-        Opt(|f, t| Some(t.tap.as_ref()?.channels.ringing_amplitude * f.u.length));
-    "modulus_dmt", Own("Pa", "α4 (Hertz group)"), true, "fitted DMT modulus of the retract (PF-QNM)",
-        Opt(|f, t| Some(t.tap.as_ref()?.fit?.hertz_group * f.modulus_scale));
-    "taps_per_cycle", Fixed("1"), true, "contacts per modulation period",
-        Opt(|_, t| Some(t.tap.as_ref()?.channels.taps_per_cycle));
-    "z_c", Length, true, "mean rest separation",
-        Opt(|f, t| Some(t.params.rest_distance() * f.u.length));
-};
-
-/// The names of a sweep's channels ([`COLUMNS`]), in the order of its table.
-pub(crate) fn channel_names() -> Vec<&'static str> {
-    columns::names(&COLUMNS)
 }
 
 /// The `sweep` block of the document: the swept quantity and its values, each channel of
@@ -303,20 +260,4 @@ pub(crate) fn sweep_layout(sweep: &PeakForceSweep, frame: &Frame, taps: &[SweepT
         Values::F64(period.collect()),
     ));
     Layout::new("peakforce sweep", &[(dim, sweep.values.len())], variables)
-}
-
-/// One value of a PeakForce sweep: its place, the model it was computed on (α5 is the tap's:
-/// the feedback's with a setpoint), and the steady tap or why it failed.
-#[derive(Debug, Clone)]
-pub struct SweepTap {
-    /// Place of the value in the sweep (0-based).
-    pub index: usize,
-    /// The model's parameters of this tap (α5 found by the feedback with a setpoint).
-    pub params: Params,
-    /// The steady tap (`None` when the point failed).
-    pub tap: Option<SteadyTap>,
-    /// Steady taps computed for this value (1 without a setpoint).
-    pub evaluations: usize,
-    /// Why the point failed (`None` when it was computed).
-    pub message: Option<String>,
 }

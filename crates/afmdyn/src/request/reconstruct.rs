@@ -30,13 +30,13 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::present::reconstruct::{reconstruction, Inversion};
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
 use crate::analysis::reconstruct::{sader_jarvis, Method, Reconstruction, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
 use crate::analysis::reconstruct_exact::{check_exact, exact_inversion, exact_weights};
 use crate::error::{number, SimError};
+use crate::report::present::reconstruct::{reconstruction, Inversion};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -351,7 +351,7 @@ impl Analysis for ReconstructRequest {
     }
 }
 
-/// A reconstruction's presentation at `to` ([`super::present::reconstruct::reconstruction`]),
+/// A reconstruction's presentation at `to` ([`crate::report::present::reconstruct::reconstruction`]),
 /// the printed document naming its table.
 fn present_reconstruction(
     r: &Reconstruction,
@@ -362,8 +362,7 @@ fn present_reconstruction(
     to: super::run::Destination<'_>,
 ) -> Result<crate::report::Presentation, SimError> {
     let mut document = document.clone();
-    let files = (to.files, to.dir);
-    let mut shown = reconstruction(r, how, law, &mut document, units, files);
+    let mut shown = reconstruction(r, how, law, &mut document, units, to);
     shown.document = Some(document);
     Ok(shown)
 }

@@ -158,39 +158,7 @@ pub trait Analysis {
     }
 }
 
-/// Where a front end writes a result ([`Analysis::present`]): which files, the directory
-/// (none: no files written) and the naming of a stepped curve's columns.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Destination<'a> {
-    /// The files written: all, the data without the figures, or none.
-    pub files: super::present::Files,
-    /// The output directory.
-    pub dir: Option<&'a std::path::Path>,
-    /// A stepped curve's CSV/NPY columns named and ordered as dForce 2.0's zcdom table.
-    pub dforce_columns: bool,
-}
-
-impl Destination<'_> {
-    /// A stepped curve's options at this destination, its files named `stem`.
-    pub fn curve(&self, stem: &'static str) -> CurveOptions {
-        CurveOptions {
-            stem,
-            files: self.files,
-            dforce_columns: self.dforce_columns,
-        }
-    }
-    /// `shown` without the files [`Destination::files`] leaves out (the figures, or all).
-    pub fn keep(&self, shown: &mut report::Presentation) {
-        use super::present::Files;
-        match self.files {
-            Files::All => {}
-            Files::Data => shown
-                .files
-                .retain(|f| !matches!(f, report::OutputFile::Figure { .. })),
-            Files::None => shown.files.clear(),
-        }
-    }
-}
+pub use crate::report::present::Destination;
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
@@ -317,7 +285,7 @@ impl Analysis for OrbitRequest {
         units: report::TextUnits,
         _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        super::present::orbits::orbit(&model.params, output, units)
+        crate::report::present::orbits::orbit(&model.params, output, units)
     }
 }
 
@@ -363,7 +331,7 @@ impl Analysis for ContinuationRequest {
         units: report::TextUnits,
         _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        super::present::continuation::continuation(
+        crate::report::present::continuation::continuation(
             &model.params,
             self.param,
             self.from,
@@ -409,7 +377,7 @@ impl Analysis for LyapunovRequest {
         units: report::TextUnits,
         _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::orbits::lyapunov(
+        Ok(crate::report::present::orbits::lyapunov(
             &model.params,
             output,
             units,
@@ -444,11 +412,14 @@ impl Analysis for AttractorsRequest {
         units: report::TextUnits,
         _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        let mut shown =
-            super::present::census::attractors(self, &model.params, r, document, units)?;
+        let spec = self.spec(&model.params)?;
+        let mut shown = crate::report::present::census::attractors(&spec, r, document, units)?;
         shown
             .warnings
-            .extend(super::present::census::failed_starts(r, self.samples));
+            .extend(crate::report::present::census::failed_starts(
+                r,
+                self.samples,
+            ));
         Ok(shown)
     }
 }
@@ -480,10 +451,7 @@ impl Analysis for ObserveRequest {
         })
     }
     fn report(&self, model: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
-        let units = match &model.probe {
-            Some(p) => CurveUnits::from_scales(&p.scales, false),
-            None => CurveUnits::dimensionless(),
-        };
+        let units = CurveUnits::of(model.probe.as_ref(), false);
         let mut doc = report::observables(&o.observables);
         doc["reported"] = report::observed(&o.observables, &units);
         Ok(doc)
@@ -516,7 +484,7 @@ impl Analysis for ConvergeRequest {
         _: report::TextUnits,
         to: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        let mut shown = super::present::converge::converge(&model.params, runs);
+        let mut shown = crate::report::present::converge::converge(&model.params, runs);
         // the printed document names the output directory
         if let Some(dir) = to.dir {
             let mut document = document.clone();
@@ -567,10 +535,7 @@ pub struct ApproachRequest {
 impl ApproachRequest {
     /// The units of the curve: SI (m, N, J) with a probe, else the model's.
     pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        match &model.probe {
-            Some(p) => CurveUnits::from_scales(&p.scales, false),
-            None => CurveUnits::dimensionless(),
-        }
+        CurveUnits::of(model.probe.as_ref(), false)
     }
 }
 
@@ -629,10 +594,7 @@ impl Default for ResonanceRequest {
 impl ResonanceRequest {
     /// The units of the curve: SI (m, N, J, Hz) with a probe, else the model's.
     pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        match &model.probe {
-            Some(p) => CurveUnits::from_scales(&p.scales, true),
-            None => CurveUnits::dimensionless(),
-        }
+        CurveUnits::of(model.probe.as_ref(), true)
     }
 }
 
@@ -653,17 +615,6 @@ impl ResonanceRequest {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(transparent)]
 pub struct Bimodal(pub ApproachRequest);
-
-/// How a stepped curve's presentation is made (`--files`, `--dforce-columns`).
-#[derive(Debug, Clone, Copy)]
-pub struct CurveOptions {
-    /// The files' stem (`approach`, `bimodal`, `resonance`).
-    pub stem: &'static str,
-    /// Which files: all (data and figures), the data, none.
-    pub files: super::present::Files,
-    /// Name and order the table's columns as dForce 2.0's `zcdom` table.
-    pub dforce_columns: bool,
-}
 
 #[cfg(test)]
 mod tests {

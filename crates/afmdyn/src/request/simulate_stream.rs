@@ -1,6 +1,6 @@
 //! `simulate` streamed to files ([`SimulateStream`]): the run is recorded in chunks of whole
 //! periods (`crate::trajectory::chunked::record_chunked`) and every chunk is written to the
-//! data files (`super::simulate_files::SeriesFiles`) as it comes, while what the plots and
+//! data files (`crate::report::simulate_files::SeriesFiles`) as it comes, while what the plots and
 //! the spectrum need is gathered in bounded memory ([`PlotData`]); memory does not grow with
 //! the length of the run. Its [`Analysis`] checks the series' bytes against the files' budget
 //! ([`SeriesStore::Files`]) and the run's cost before any work; `execute` is the run itself
@@ -11,7 +11,6 @@ use super::analyses::{initial_state, SeriesStore, SimulateRequest, SimulateSpan}
 use super::costs::{state_bytes, MODEL_BYTES};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
-use super::simulate_files::{SeriesFiles, SERIES_FILES};
 use crate::analysis::progress::Progress;
 use crate::analysis::spectrum::amplitude_spectrum;
 use crate::analysis::spectrum::SPECTRUM_SAMPLES;
@@ -22,6 +21,7 @@ use crate::layout::figure::{Figure, Plot, Series, Style};
 use crate::layout::files::f;
 use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::report::simulate_files::{SeriesFiles, SERIES_FILES};
 use crate::report::Presentation;
 use crate::report::{self, SeriesUnits, SimulateSummary};
 use crate::system::Region;

@@ -16,7 +16,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
-use crate::request::basins::document;
+use crate::report::basins::document;
 use crate::request::costs::{basins_cost, check_cost};
 use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
@@ -127,13 +127,13 @@ impl Analysis for BasinsRequest {
     ) -> Result<crate::report::Presentation, SimError> {
         let spec = self.spec(&model.params)?;
         let Some(dir) = to.dir else {
-            return crate::request::present::maps::basins(&spec, map, document);
+            return crate::report::present::maps::basins(&spec, map, document);
         };
         // the document (basins.json too) names the files written
         let mut document = document.clone();
         document["csv"] = serde_json::json!(dir.join("basins.csv"));
         document["netcdf"] = serde_json::json!(dir.join("basins.nc"));
-        let mut shown = crate::request::present::maps::basins(&spec, map, &document)?;
+        let mut shown = crate::report::present::maps::basins(&spec, map, &document)?;
         shown.document = Some(document);
         shown.outputs_note = crate::report::OutputsNote::Tail;
         Ok(shown)

@@ -62,7 +62,7 @@ impl Analysis for Chart {
         _: crate::report::TextUnits,
         to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let mut shown = crate::request::present::maps::chart(self, cells);
+        let mut shown = crate::report::present::maps::chart(&self.view(), cells);
         // the printed document names the files written
         if let Some(dir) = to.dir {
             let mut document = document.clone();

@@ -133,8 +133,10 @@ impl Analysis for GlobalContinuationRequest {
         _: report::TextUnits,
         _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        Ok(crate::request::present::census::global_continuation(
-            self, steps, document,
+        Ok(crate::report::present::census::global_continuation(
+            (self.param, self.samples),
+            steps,
+            document,
         ))
     }
 }

@@ -219,9 +219,8 @@ impl Analysis for PeakForceRequest {
         to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        let (files, dir) = (to.files, to.dir);
-        let p = crate::request::present::peakforce::peakforce;
-        Ok(p(&mut document, units, files, dir))
+        let p = crate::report::present::peakforce::peakforce;
+        Ok(p(&mut document, units, to))
     }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
         // a sweep's largest over its taps

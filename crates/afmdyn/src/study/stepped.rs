@@ -22,9 +22,9 @@ use crate::analysis::stepped::{
 use crate::error::SimError;
 use crate::params::Params;
 use crate::report;
+use crate::report::present::curves::{stepped, CurveKind};
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
-use crate::request::present::curves::{stepped, CurveKind};
 use crate::request::run::{
     Analysis, ApproachRequest, Bimodal, Destination, Resolved, ResonanceRequest,
 };
@@ -138,7 +138,7 @@ impl CurveStudy {
 }
 
 /// [`Analysis::present`] of a stepped curve of kind `$kind`: its presentation
-/// ([`crate::request::present::curves::stepped`]) with every file, named as the request.
+/// ([`crate::report::present::curves::stepped`]) with every file, named as the request.
 macro_rules! present_curve {
     ($kind:expr) => {
         fn present(
@@ -151,7 +151,7 @@ macro_rules! present_curve {
         ) -> Result<report::Presentation, SimError> {
             Ok(stepped(
                 $kind,
-                model,
+                (&model.params, model.probe.as_ref()),
                 c,
                 document,
                 units,
@@ -339,7 +339,7 @@ impl Analysis for Bimodal {
         let options = to.curve("bimodal");
         Ok(stepped(
             CurveKind::Approach,
-            model,
+            (&model.params, model.probe.as_ref()),
             c,
             document,
             units,

@@ -124,7 +124,7 @@ impl Analysis for BifurcationRequest {
     }
     fn report(&self, model: &Resolved, records: &Self::Output) -> Result<Value, SimError> {
         let spec = self.spec(&model.params)?;
-        let mut tally = crate::request::present::sweeps::SweepTally::default();
+        let mut tally = crate::report::present::sweeps::SweepTally::default();
         for r in records {
             tally.add(r);
         }

@@ -1,10 +1,20 @@
 //! The one layout of a chart's results (issue 29): [`ChartArrays`], the variables of
 //! `chart.nc` and of Python's `xarray.Dataset`, and [`CSV_HEADER`] / [`csv_lines`], the rows of
-//! `chart.csv` (the request is [`super::chart`]'s).
+//! `chart.csv` (the request is `crate::request::chart`'s).
 
-use super::chart::{axis_unit, Chart};
-use crate::analysis::chart::ChartCell;
+use crate::analysis::chart::{ChartCell, ChartSpec};
 use crate::layout::{Layout, Variable};
+
+/// A chart axis as its files name it: the parameter's name, its symbol and its unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ChartAxis<'a> {
+    /// The parameter's name (`omega`, `free_amplitude`).
+    pub(crate) name: &'a str,
+    /// Its symbol (`Ω`; the name where it has none).
+    pub(crate) symbol: &'a str,
+    /// Its unit (`"1"` dimensionless).
+    pub(crate) unit: &'a str,
+}
 
 /// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
 /// empty, for a cell without any).
@@ -31,11 +41,9 @@ pub const CSV_HEADER: [&str; 18] = [
 
 /// The rows of a cell as CSV lines of [`CSV_HEADER`] (numbers in Rust's shortest round-trip
 /// form; messages with commas and newlines replaced by spaces). The lengths `x_max` and
-/// `v_t_min` are in g₀, or in m with a probe (×
-/// [`ChartModel::length_m`](super::chart::ChartModel::length_m) of the cell: the length unit
-/// changes from cell to cell along a `free_amplitude` axis).
-pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
-    let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
+/// `v_t_min` are in g₀ × `length`: 1, or the metres per g₀ of the cell with a probe (the
+/// length unit changes from cell to cell along a `free_amplitude` axis).
+pub(crate) fn csv_lines(length: f64, cell: &ChartCell) -> Vec<String> {
     let message = cell
         .message
         .as_deref()
@@ -74,7 +82,7 @@ pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
 
 /// A chart's results as arrays: per cell (y, x) and per attractor slot (y, x, attractor), the
 /// attractor slots of a cell in its order
-/// ([`ChartRequest::max_attractors`](super::chart::ChartRequest::max_attractors) of them,
+/// (`crate::request::ChartRequest::max_attractors` of them,
 /// empty ones padded: period 0, NaN). Row-major, y slowest. The one layout of `chart.nc`, of
 /// Python's `xarray.Dataset` and of the Dask store's regions.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,20 +122,21 @@ pub struct ChartArrays {
 }
 
 impl ChartArrays {
-    /// The chart's layout (`chart.nc`, Python's dataset, the Dask Zarr store): coordinates `x`
-    /// and `y` in their axes' units (named by the axes `x_name`, `y_name`), per cell (y, x)
-    /// `attractors`, `failures`, `dominant_period`, and per attractor slot (y, x, attractor)
-    /// `period`, `motion`, `lyapunov`, `lyapunov_error`, `x_max`, `v_t_min`,
+    /// The chart's layout over the axes `x` and `y` (`chart.nc`, Python's dataset, the Dask
+    /// Zarr store): coordinates `x` and `y` in their axes' units (named by the axes), per cell
+    /// (y, x) `attractors`, `failures`, `dominant_period`, and per attractor slot
+    /// (y, x, attractor) `period`, `motion`, `lyapunov`, `lyapunov_error`, `x_max`, `v_t_min`,
     /// `contacts_per_period`, `contact_fraction`, `fraction`.
-    pub fn layout(&self, x_name: &str, y_name: &str) -> Layout {
+    pub(crate) fn layout_over(&self, x: ChartAxis<'_>, y: ChartAxis<'_>) -> Layout {
+        let (x_name, y_name) = (x.name, y.name);
         let (cell, slot): (&[&str], &[&str]) = (&["y", "x"], &["y", "x", "attractor"]);
         let a = self;
         Layout::new(
             format!("afmdyn behaviour chart over {x_name} and {y_name}"),
             &[("x", a.x.len()), ("y", a.y.len()), ("attractor", a.slots)],
             vec![
-                Variable::f64("x", &["x"], axis_unit(x_name), x_name, &a.x),
-                Variable::f64("y", &["y"], axis_unit(y_name), y_name, &a.y),
+                Variable::f64("x", &["x"], x.unit, x_name, &a.x),
+                Variable::f64("y", &["y"], y.unit, y_name, &a.y),
                 Variable::i32(
                     "attractors",
                     cell,
@@ -217,28 +226,19 @@ impl ChartArrays {
         )
     }
 
-    /// The arrays of `cells` (any order; each cell once) of the whole chart.
-    pub fn new(chart: &Chart, cells: &[ChartCell]) -> ChartArrays {
-        ChartArrays::region(
-            chart,
-            (0, 0),
-            (chart.spec.x.len(), chart.spec.y.len()),
-            cells,
-        )
-    }
-
-    /// The arrays of the region of `size` = (columns, rows) from the cell `origin` = (ix, iy):
-    /// a task's tile is the region ((lo, iy), (hi − lo, 1)); cells outside it are left out.
-    pub fn region(
-        chart: &Chart,
+    /// The arrays of the region of `size` = (columns, rows) from the cell `origin` = (ix, iy)
+    /// of the chart over `spec` with `slots` attractor slots per cell: a task's tile is the
+    /// region ((lo, iy), (hi − lo, 1)); cells outside it are left out.
+    pub(crate) fn region_of(
+        (spec, slots): (&ChartSpec, usize),
         origin: (usize, usize),
         size: (usize, usize),
         cells: &[ChartCell],
     ) -> ChartArrays {
-        let slots = chart.slots.max(1);
+        let slots = slots.max(1);
         let (x0, y0) = origin;
-        let x = &chart.spec.x[x0.min(chart.spec.x.len())..(x0 + size.0).min(chart.spec.x.len())];
-        let y = &chart.spec.y[y0.min(chart.spec.y.len())..(y0 + size.1).min(chart.spec.y.len())];
+        let x = &spec.x[x0.min(spec.x.len())..(x0 + size.0).min(spec.x.len())];
+        let y = &spec.y[y0.min(spec.y.len())..(y0 + size.1).min(spec.y.len())];
         let (nx, ny) = (x.len(), y.len());
         let n = nx * ny;
         let mut a = ChartArrays {

@@ -1,11 +1,10 @@
 //! `fm`: the summary of a frequency-modulation curve, its table `fm.csv`, its document
 //! `fm.json` and the frequency-shift figure.
 
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
 use crate::layout::figure::{Series, Style};
-use crate::report::{OutputsNote, Presentation, TextUnits};
+use crate::report::{Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
 
 /// The presentation of an FM curve's `document` ([`crate::request::fm::document`]) and its
 /// table (column names and rows, [`crate::request::fm::table`]): the summary (Δf at both ends,
@@ -16,13 +15,9 @@ pub(crate) fn fm(
     document: &mut Value,
     (columns, table): (Vec<&str>, Vec<Vec<f64>>),
     text: TextUnits,
-    files: Files,
-    dir: Option<&Path>,
+    to: Destination<'_>,
 ) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+    let mut p = tail();
     let k = |name: &str| columns.iter().position(|c| *c == name).unwrap_or(0);
     let si = text.si();
     let value = |v: f64, si_unit: &str, model_unit: &str| {
@@ -49,19 +44,11 @@ pub(crate) fn fm(
         table.iter().filter(|r| r[k("stable")] == 0.0).count(),
         document["folds"].as_array().map_or(0, Vec::len),
     ));
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let text = table
-            .iter()
-            .map(|r| r.iter().map(|v| f(*v)).collect())
-            .collect();
-        p.csv("fm.csv", &columns, text);
-    }
-    if files == Files::All {
+    numeric_csv(&mut p, "fm.csv", &columns, &table);
+    if to.files == Files::All {
         let (x_unit, y_unit) = if si {
             (" (m)", " (Hz)")
         } else {
@@ -81,6 +68,6 @@ pub(crate) fn fm(
         let title = "FM-AFM: frequency shift at constant amplitude";
         p.figure("fm-frequency-shift", lines(title, labels, vec![series]));
     }
-    with_document(&mut p, document, ("fm.json", "fm.csv"), dir);
+    with_document(&mut p, document, ("fm.json", "fm.csv"), to.dir);
     p
 }

@@ -1,6 +1,7 @@
 //! `attractors` and `attractors --sweep`: their summaries, tables, datasets and figures.
 
 use crate::analysis::attractors::{Attractor, AttractorReport};
+use crate::analysis::attractors::{AttractorSpec, ATTRACTOR_SAMPLES_PER_PERIOD};
 use crate::analysis::global_continuation::ContinuationStep;
 use crate::error::SimError;
 use crate::integrate::build;
@@ -8,9 +9,8 @@ use crate::layout::figure::{Figure, IdSeries, Plot, Series, StackedFractions, St
 use crate::layout::files::f;
 use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::params::SweepParam;
 use crate::report::{self, OutputFile, Presentation, TextUnits};
-use crate::request::analyses::{AttractorsRequest, GlobalContinuationRequest};
-use crate::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use crate::system::Region;
 use crate::trajectory::{record, RecordSpec, Trajectory};
 use serde_json::Value;
@@ -30,16 +30,15 @@ fn period_short(period: Option<usize>) -> String {
 /// with the Poincaré points —, `attractors.json` (`document`) and the summary in `u`.
 ///
 /// # Errors
-/// [`SimError`] when the model or the request's integrator cannot be built, or a recording
+/// [`SimError`] when the model or the census's integrator cannot be built, or a recording
 /// fails.
 pub(crate) fn attractors(
-    request: &AttractorsRequest,
-    p: &Params,
+    spec: &AttractorSpec,
     report: &AttractorReport,
     document: &Value,
     u: TextUnits,
 ) -> Result<Presentation, SimError> {
-    let spec = request.spec(p)?;
+    let p = &spec.params;
     let model = CantileverModel::new(p)?;
     let mut s = Presentation::default();
     for (k, att) in report.attractors.iter().enumerate() {
@@ -63,7 +62,7 @@ pub(crate) fn attractors(
         name: "attractors.json".into(),
         value: document.clone(),
     });
-    summary(&mut s, request, p, report, u);
+    summary(&mut s, spec.samples, p, report, u);
     Ok(s)
 }
 
@@ -137,12 +136,12 @@ fn attractor_files(
     );
 }
 
-/// The census's summary into `s`: the attractors found from the request's starts at `p`,
+/// The census's summary into `s`: the attractors found from `samples` starts at `p`,
 /// each with its period, basin, largest excursion, closest approach and contact fraction, and
 /// the starts still unsettled; lengths in `u` (g₀, or m with a probe).
 fn summary(
     s: &mut Presentation,
-    request: &AttractorsRequest,
+    samples: usize,
     p: &Params,
     report: &AttractorReport,
     u: TextUnits,
@@ -150,7 +149,7 @@ fn summary(
     s.line(format!(
         "{} attractors from {} starts ({} failed) at {}{}:",
         report.attractors.len(),
-        request.samples,
+        samples,
         report.failures.len(),
         u.drive(p.omega),
         if u.si() {
@@ -207,12 +206,12 @@ pub(crate) fn failed_starts(report: &AttractorReport, samples: usize) -> Option<
 /// dataset `attractors-sweep.nc`, the stacked basin fractions, `attractors-sweep.json`
 /// (`document`) and the summary (per value, each id with its period and basin).
 pub(crate) fn global_continuation(
-    request: &GlobalContinuationRequest,
+    (param, samples): (SweepParam, usize),
     steps: &[ContinuationStep],
     document: &Value,
 ) -> Presentation {
     let mut s = Presentation::default();
-    let name = request.param.name();
+    let name = param.name();
     let mut rows = Vec::new();
     for st in steps {
         for (id, x) in &st.attractors {
@@ -248,7 +247,7 @@ pub(crate) fn global_continuation(
     );
     s.dataset(
         "attractors-sweep.nc",
-        report::global_continuation_layout(request.param, steps),
+        report::global_continuation_layout(param, steps),
     );
     let ids = document["ids"].as_u64().unwrap_or(0) as usize;
     let per_id: Vec<IdSeries> = (0..ids)
@@ -275,10 +274,10 @@ pub(crate) fn global_continuation(
         Plot::Stacked(StackedFractions {
             title: format!(
                 "Attractors over {} ({} random starts per value)",
-                request.param.symbol(),
-                request.samples
+                param.symbol(),
+                samples
             ),
-            x_label: request.param.symbol().into(),
+            x_label: param.symbol().into(),
             values: steps.iter().map(|st| st.value).collect(),
             ids: per_id,
         }),
@@ -290,7 +289,7 @@ pub(crate) fn global_continuation(
     s.line(format!(
         "{ids} attractors over {} values of {name} ({} random starts each):",
         steps.len(),
-        request.samples
+        samples
     ));
     for st in steps {
         let line: Vec<String> = (st.attractors.iter())

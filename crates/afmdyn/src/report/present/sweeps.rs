@@ -6,9 +6,9 @@
 #[cfg(feature = "files")]
 use crate::error::SimError;
 use crate::params::{Params, SweepParam};
-use crate::request::sweep::SweepRecord;
+use crate::report::sweep::SweepRecord;
 #[cfg(feature = "files")]
-use crate::request::sweep::{sweep_failure, COL_W_TIP, COL_X_MAX};
+use crate::report::sweep::{sweep_failure, COL_W_TIP, COL_X_MAX};
 use serde_json::{json, Value};
 use std::collections::HashSet;
 
@@ -36,7 +36,7 @@ pub(crate) struct SweepRow<'a> {
     pub x_max: f64,
     /// `periodic`, `nonperiodic` or `error`.
     pub status: &'a str,
-    /// The status code ([`crate::request::sweep::status_code`]).
+    /// The status code ([`crate::report::sweep::status_code`]).
     pub code: f64,
     /// Whether the row is its sweep point's first (`point` = 0).
     pub first: bool,
@@ -75,7 +75,7 @@ impl<'a> SweepRow<'a> {
     /// The row of a line of the store's CSV (unreadable numbers as NaN).
     #[cfg(feature = "files")]
     pub(crate) fn from_csv(r: &'a csv::StringRecord) -> Self {
-        use crate::request::sweep::*;
+        use crate::report::sweep::*;
         let num = |c: usize| r[c].parse().unwrap_or(f64::NAN);
         SweepRow {
             value: num(COL_VALUE),
@@ -276,38 +276,18 @@ pub struct SweepFiles {
     pub npy: std::path::PathBuf,
 }
 
-/// A diagram's points, streamed from the store's CSV ([`diagram_point`] of each row): the
-/// memory of a large sweep's figures stays bounded.
+/// A diagram's points, streamed from the store's CSV ([`diagram_point`] of each row, read by
+/// the store: `crate::request::checkpoint_file`): the memory of a large sweep's figures stays
+/// bounded.
 #[cfg(feature = "files")]
 #[derive(Debug)]
-struct StoredDiagram {
-    csv: std::path::PathBuf,
-    column: usize,
-    by_branch: bool,
-}
-
-#[cfg(feature = "files")]
-impl crate::layout::figure::PointSource for StoredDiagram {
-    fn feed(
-        &self,
-        draw: &mut crate::layout::figure::PointSink<'_>,
-    ) -> Result<(), crate::layout::figure::FeedError> {
-        use crate::layout::figure::FeedError;
-        let mut chunk = Vec::with_capacity(4096);
-        crate::request::checkpoint_file::each_row(&self.csv, &mut |r| -> Result<(), FeedError> {
-            chunk.extend(diagram_point(
-                SweepRow::from_csv(r),
-                self.column,
-                self.by_branch,
-            ));
-            if chunk.len() == chunk.capacity() {
-                draw(&chunk).map_err(FeedError::Io)?;
-                chunk.clear();
-            }
-            Ok(())
-        })?;
-        draw(&chunk).map_err(FeedError::Io)
-    }
+pub(crate) struct StoredDiagram {
+    /// The store's CSV of the finished rows.
+    pub(crate) csv: std::path::PathBuf,
+    /// The column drawn ([`crate::report::sweep::COL_W_TIP`] or `COL_X_MAX`).
+    pub(crate) column: usize,
+    /// Colour the points by their branch.
+    pub(crate) by_branch: bool,
 }
 
 /// The presentation of a sweep run into its store ([`SweepFiles`]): its summary line (the

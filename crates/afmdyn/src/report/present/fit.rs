@@ -4,11 +4,43 @@
 //! beside the data (against time too, for `sls`) and of the residuals.
 
 use super::peakforce::rows;
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
 use crate::layout::figure::{Series, Style};
-use crate::report::{OutputsNote, Presentation, TextUnits};
+use crate::report::{Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
+
+/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
+/// Dataset, those of the channels fitted.
+pub(crate) const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
+    ("z", "m", "piezo position"),
+    ("amplitude", "m", "amplitude, measured"),
+    ("amplitude_fit", "m", "amplitude, fitted"),
+    ("amplitude_residual", "m", "measured − fitted amplitude"),
+    ("phase", "deg", "phase, measured"),
+    ("phase_fit", "deg", "phase, fitted"),
+    ("phase_residual", "deg", "measured − fitted phase"),
+    ("amplitude_2", "m", "second component's amplitude, measured"),
+    (
+        "amplitude_2_fit",
+        "m",
+        "second component's amplitude, fitted",
+    ),
+    (
+        "amplitude_2_residual",
+        "m",
+        "measured − fitted second amplitude",
+    ),
+    ("phase_2", "deg", "second component's phase, measured"),
+    ("phase_2_fit", "deg", "second component's phase, fitted"),
+    ("phase_2_residual", "deg", "measured − fitted second phase"),
+    ("frequency_shift", "Hz", "frequency shift, measured"),
+    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
+    (
+        "frequency_shift_residual",
+        "Hz",
+        "measured − fitted frequency shift",
+    ),
+];
 
 /// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
 pub(crate) const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
@@ -56,16 +88,8 @@ fn held_line(document: &Value, text: TextUnits) -> Option<String> {
 
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
-pub(crate) fn fit(
-    document: &mut Value,
-    text: TextUnits,
-    files: Files,
-    dir: Option<&Path>,
-) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+pub(crate) fn fit(document: &mut Value, text: TextUnits, to: Destination<'_>) -> Presentation {
+    let mut p = tail();
     let units = document["units"].clone();
     if let Some(est) = document["estimates"].as_object() {
         for (name, e) in est {
@@ -94,12 +118,12 @@ pub(crate) fn fit(
         document["chi2_dof"].as_f64().unwrap_or(f64::NAN),
         document["noise"].as_str().unwrap_or(""),
     ));
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
     if dynamic.is_some() {
-        am_files(&mut p, document, files);
-        with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+        am_files(&mut p, document, to.files);
+        with_document(&mut p, document, ("fit.json", "fit-curve.csv"), to.dir);
         return p;
     }
     // a time-dependent law's curve (sls) carries the rows' times: a column and a figure more
@@ -109,16 +133,8 @@ pub(crate) fn fit(
         columns.push("time");
     }
     let curve = rows(document, "curve", &columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = curve
-            .iter()
-            .map(|r| r.iter().map(|v| f(*v)).collect())
-            .collect();
-        p.csv("fit-curve.csv", &columns, table);
-    }
-    if files == Files::All {
+    numeric_csv(&mut p, "fit-curve.csv", &columns, &curve);
+    if to.files == Files::All {
         let against = |x: usize, label: &str, col: usize, style: Style, color: usize| Series {
             label: label.into(),
             points: curve
@@ -166,28 +182,20 @@ pub(crate) fn fit(
             );
         }
     }
-    with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+    with_document(&mut p, document, ("fit.json", "fit-curve.csv"), to.dir);
     p
 }
 
 /// The table and figures of a dynamic (AM or FM) fit ([`crate::request::fit_dynamic`]): the columns
 /// of the channels fitted, each channel's data and fit against z, and its residuals.
 fn am_files(p: &mut Presentation, document: &Value, files: Files) {
-    let columns: Vec<&str> = crate::request::fit_result::CURVE_VARIABLES
+    let columns: Vec<&str> = CURVE_VARIABLES
         .iter()
         .map(|v| v.0)
         .filter(|k| document["curve"][k].is_array())
         .collect();
     let curve = rows(document, "curve", &columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = curve
-            .iter()
-            .map(|r| r.iter().map(|v| f(*v)).collect())
-            .collect();
-        p.csv("fit-curve.csv", &columns, table);
-    }
+    numeric_csv(p, "fit-curve.csv", &columns, &curve);
     if files != Files::All {
         return;
     }

@@ -1,12 +1,11 @@
 //! `reconstruct`: the summary of a reconstructed force, its table `reconstruct.csv`, its
 //! document `reconstruct.json` and the force figure.
 
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
 use crate::analysis::reconstruct::Reconstruction;
 use crate::layout::figure::{Series, Style};
-use crate::report::{OutputsNote, Presentation, TextUnits};
+use crate::report::{Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
 
 /// Where a reconstruction comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,12 +29,9 @@ pub(crate) fn reconstruction(
     law: Option<Vec<f64>>,
     document: &mut Value,
     text: TextUnits,
-    (files, dir): (Files, Option<&Path>),
+    to: Destination<'_>,
 ) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+    let mut p = tail();
     let (k, f) = r
         .force
         .iter()
@@ -64,22 +60,19 @@ pub(crate) fn reconstruction(
             },
         ));
     }
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let rows = r
-            .distance
-            .iter()
-            .zip(&r.force)
-            .zip(&r.potential)
-            .map(|((d, force), u)| vec![f(*d), f(*force), f(*u)])
-            .collect();
-        p.csv("reconstruct.csv", &["distance", "force", "potential"], rows);
-    }
-    if files == Files::All {
+    let rows: Vec<_> = (r.distance.iter().zip(&r.force).zip(&r.potential))
+        .map(|((d, force), u)| vec![*d, *force, *u])
+        .collect();
+    numeric_csv(
+        &mut p,
+        "reconstruct.csv",
+        &["distance", "force", "potential"],
+        &rows,
+    );
+    if to.files == Files::All {
         let points = |ys: &[f64]| r.distance.iter().copied().zip(ys.iter().copied()).collect();
         let reconstructed = Series {
             label: "reconstructed".into(),
@@ -109,7 +102,7 @@ pub(crate) fn reconstruction(
         &mut p,
         document,
         ("reconstruct.json", "reconstruct.csv"),
-        dir,
+        to.dir,
     );
     p
 }

@@ -10,9 +10,21 @@ use crate::analysis::approach::rest_distance;
 use crate::analysis::stepped::{SteppedCurve, Sweep};
 use crate::analysis::traces::Traces;
 use crate::layout::{Layout, Variable};
+use crate::params::Params;
+use crate::probe::Probe;
 use crate::report::{CurveUnits, OutputsNote, Presentation, TextUnits};
-use crate::request::run::{ApproachRequest, CurveOptions, Resolved, ResonanceRequest};
 use serde_json::Value;
+
+/// How a stepped curve's presentation is made (`--files`, `--dforce-columns`).
+#[derive(Debug, Clone, Copy)]
+pub struct CurveOptions {
+    /// The files' stem (`approach`, `bimodal`, `resonance`).
+    pub stem: &'static str,
+    /// Which files: all (data and figures), the data, none.
+    pub files: Files,
+    /// Name and order the table's columns as dForce 2.0's `zcdom` table.
+    pub dforce_columns: bool,
+}
 
 /// Which stepped curve is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,20 +35,21 @@ pub(crate) enum CurveKind {
     Resonance,
 }
 
-/// A stepped curve's presentation: the summary (with the setpoint's operating points of an
-/// approach curve's document), and per `options` the table, figures and traces.
+/// A stepped curve's presentation at `model` (its parameters, and its probe for SI units): the
+/// summary (with the setpoint's operating points of an approach curve's document), and per
+/// `options` the table, figures and traces.
 pub(crate) fn stepped(
     kind: CurveKind,
-    model: &Resolved,
+    model: (&Params, Option<&Probe>),
     c: &SteppedCurve,
     document: &Value,
     text: TextUnits,
     options: &CurveOptions,
 ) -> Presentation {
-    let base = model.params;
+    let base = *model.0;
     let (u, x, l): (CurveUnits, Box<dyn Fn(f64) -> f64>, Labels) = match kind {
         CurveKind::Approach => {
-            let u = ApproachRequest::units(model);
+            let u = CurveUnits::of(model.1, false);
             let l = Labels {
                 stem: options.stem,
                 sweeps: ("approach", "retract"),
@@ -49,7 +62,7 @@ pub(crate) fn stepped(
             (u, Box::new(move |v| rest_distance(&base, v) * u.length), l)
         }
         CurveKind::Resonance => {
-            let u = ResonanceRequest::units(model);
+            let u = CurveUnits::of(model.1, true);
             let si = u.hz_per_omega.is_some();
             let l = Labels {
                 stem: options.stem,
@@ -74,12 +87,12 @@ pub(crate) fn stepped(
         u: &u,
         l: &l,
     };
-    present(s, model, document, options)
+    present(s, model.0, document, options)
 }
 
 /// The presentation of a curve: the summary (then, after the directory is named, the
 /// setpoint's lines), the table, the figures, the traces.
-fn present(s: &Shown<'_>, model: &Resolved, document: &Value, o: &CurveOptions) -> Presentation {
+fn present(s: &Shown<'_>, params: &Params, document: &Value, o: &CurveOptions) -> Presentation {
     let mut p = Presentation::default();
     summary(&mut p, s);
     p.outputs_note = OutputsNote::After(p.summary.len());
@@ -90,9 +103,9 @@ fn present(s: &Shown<'_>, model: &Resolved, document: &Value, o: &CurveOptions) 
         return p;
     }
     #[cfg(feature = "files")]
-    table(&mut p, s, model, o.dforce_columns);
+    table(&mut p, s, params, o.dforce_columns);
     #[cfg(not(feature = "files"))]
-    let _ = model;
+    let _ = params;
     if o.files == Files::All {
         for (stem, plot) in panels(s) {
             p.figure(&stem, plot);
@@ -113,21 +126,16 @@ fn present(s: &Shown<'_>, model: &Resolved, document: &Value, o: &CurveOptions) 
 /// `STEM.csv` and `STEM.npy` (the same numeric columns: named as the JSON document, or
 /// dForce's `zcdom` columns first with `dforce`).
 #[cfg(feature = "files")]
-fn table(p: &mut Presentation, s: &Shown<'_>, model: &Resolved, dforce: bool) {
-    use crate::layout::files::f;
+fn table(p: &mut Presentation, s: &Shown<'_>, params: &Params, dforce: bool) {
     use crate::report::{curve_table, CurveAxis};
     let axis = CurveAxis {
         name: s.l.x_name,
         label: s.l.x_label.clone(),
         sweeps: s.l.sweeps,
     };
-    let (rows, columns) = curve_table(s.c, s.x, s.u, &model.params, &axis, dforce);
+    let (rows, columns) = curve_table(s.c, s.x, s.u, params, &axis, dforce);
     let header: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
-    let text = rows
-        .iter()
-        .map(|r| r.iter().map(|v| f(*v)).collect())
-        .collect();
-    p.csv(&format!("{}.csv", s.l.stem), &header, text);
+    super::numeric_csv(p, &format!("{}.csv", s.l.stem), &header, &rows);
     p.files.push(crate::report::OutputFile::Npy {
         name: format!("{}.npy", s.l.stem),
         columns,

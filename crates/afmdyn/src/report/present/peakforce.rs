@@ -3,11 +3,71 @@
 //! `peakforce-curve.csv`, its document `peakforce.json` and the figures of force against
 //! distance and against time.
 
-use super::{lines, with_document, Files};
+use super::{lines, numeric_csv, tail, with_document, Destination, Files};
+use crate::analysis::peakforce::SteadyTap;
+use crate::layout::columns::{self, columns, Column};
 use crate::layout::figure::{Series, Style};
-use crate::report::{OutputsNote, Presentation, TextUnits};
+use crate::params::Params;
+use crate::report::{CurveUnits, Presentation, TextUnits};
 use serde_json::Value;
-use std::path::Path;
+
+/// What a sweep's columns ([`COLUMNS`]) are read through: the document's units and the factor
+/// from the fitted Hertz group to the reported modulus (the reduced modulus in Pa with a probe
+/// and a law with a tip radius, else 1).
+pub(crate) struct Frame {
+    /// The document's units.
+    pub u: CurveUnits,
+    /// Reported modulus per unit of the Hertz group.
+    pub modulus_scale: f64,
+}
+
+/// The channels of a sweep, one entry per value (missing where the point failed): the
+/// document's `sweep.channels` and `sweep.units`, the layout's variables and the columns of the
+/// table `peakforce-sweep.csv` after the swept value, in this order (the layout lists
+/// `modulus_dmt` last, [`sweep_layout`]).
+pub(crate) const COLUMNS: [Column<Frame, SweepTap>; 10] = columns! {
+    "peak_force", Force, true, "peak force",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.peak_force * f.u.force));
+    "adhesion", Force, true, "adhesion (most negative force)",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.adhesion * f.u.force));
+    "deformation", Length, true, "largest indentation",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.deformation * f.u.length));
+    "dissipation", Energy, true, "tip-sample work per cycle",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.dissipation * f.u.energy));
+    "contact_time", Own("s", "τ"), true, "time in contact per cycle",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.contact_time * f.u.time));
+    "snap_off_time", Own("s", "τ"), true, "snap-off from the largest separation",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.snap_off_time * f.u.time));
+    "ringing_amplitude", Length, true, "ringing after snap-off",
+        Opt(|f, t| Some(t.tap.as_ref()?.channels.ringing_amplitude * f.u.length));
+    "modulus_dmt", Own("Pa", "α4 (Hertz group)"), true, "fitted DMT modulus of the retract (PF-QNM)",
+        Opt(|f, t| Some(t.tap.as_ref()?.fit?.hertz_group * f.modulus_scale));
+    "taps_per_cycle", Fixed("1"), true, "contacts per modulation period",
+        Opt(|_, t| Some(t.tap.as_ref()?.channels.taps_per_cycle));
+    "z_c", Length, true, "mean rest separation",
+        Opt(|f, t| Some(t.params.rest_distance() * f.u.length));
+};
+
+/// The names of a sweep's channels ([`COLUMNS`]), in the order of its table.
+pub(crate) fn channel_names() -> Vec<&'static str> {
+    columns::names(&COLUMNS)
+}
+
+/// One value of a PeakForce sweep: its place, the model it was computed on (α5 is the tap's:
+/// the feedback's with a setpoint), and the steady tap or why it failed.
+#[derive(Debug, Clone)]
+pub struct SweepTap {
+    /// Place of the value in the sweep (0-based).
+    pub index: usize,
+    /// The model's parameters of this tap (α5 found by the feedback with a setpoint).
+    pub params: Params,
+    /// The steady tap (`None` when the point failed).
+    pub tap: Option<SteadyTap>,
+    /// Steady taps computed for this value (1 without a setpoint).
+    pub evaluations: usize,
+    /// Why the point failed (`None` when it was computed).
+    pub message: Option<String>,
+}
 
 /// The columns of the cycle's table (`peakforce-cycle.csv`, Python's Dataset variables).
 pub(crate) const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
@@ -62,7 +122,7 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
     } else {
         "modulation_frequency"
     }];
-    let channels = crate::request::peakforce_sweep::channel_names();
+    let channels = channel_names();
     columns.extend(channels.into_iter().filter(|c| *c != param));
     let channels = rows(block, "channels", &columns[1..]);
     let table = values
@@ -83,16 +143,12 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
 pub(crate) fn peakforce(
     document: &mut Value,
     text: TextUnits,
-    files: Files,
-    dir: Option<&Path>,
+    to: Destination<'_>,
 ) -> Presentation {
-    let mut p = Presentation {
-        outputs_note: OutputsNote::Tail,
-        ..Presentation::default()
-    };
+    let mut p = tail();
     let sweep = sweep_table(document);
     summary(&mut p, document, text, sweep.as_ref());
-    if files == Files::None {
+    if to.files == Files::None {
         return p;
     }
     let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
@@ -107,21 +163,12 @@ pub(crate) fn peakforce(
         CURVE_COLUMNS.to_vec()
     };
     let curve = rows(document, "curve", &curve_columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = |t: &[Vec<f64>]| {
-            t.iter()
-                .map(|r| r.iter().map(|v| f(*v)).collect())
-                .collect()
-        };
-        p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
-        p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
-        if let Some((_, rows, columns)) = &sweep {
-            p.csv("peakforce-sweep.csv", columns, table(rows));
-        }
+    numeric_csv(&mut p, "peakforce-cycle.csv", &CYCLE_COLUMNS, &cycle);
+    numeric_csv(&mut p, "peakforce-curve.csv", &curve_columns, &curve);
+    if let Some((_, rows, columns)) = &sweep {
+        numeric_csv(&mut p, "peakforce-sweep.csv", columns, rows);
     }
-    if files == Files::All {
+    if to.files == Files::All {
         figures(
             &mut p,
             document,
@@ -134,7 +181,7 @@ pub(crate) fn peakforce(
         &mut p,
         document,
         ("peakforce.json", "peakforce-cycle.csv"),
-        dir,
+        to.dir,
     );
     p
 }

@@ -2,25 +2,37 @@
 //! `basins.nc`), cell maps and text summaries.
 
 use crate::analysis::basins::{BasinMap, BasinSpec};
-use crate::analysis::chart::ChartCell;
+use crate::analysis::chart::{ChartCell, ChartSpec};
 use crate::error::SimError;
 use crate::layout::figure::{palette, CellMap, Plot, Rgb};
 use crate::model::CantileverModel;
+use crate::report::basins::{csv_text, BasinArrays};
+use crate::report::chart_layout::{csv_lines, ChartArrays, ChartAxis, CSV_HEADER};
 use crate::report::Presentation;
-use crate::request::basins::{csv_text, BasinArrays};
-use crate::request::chart::{axis_unit, csv_lines, Chart, ChartArrays, CSV_HEADER};
-use crate::request::parameter;
 use serde_json::Value;
 
+/// A chart as its presentation reads it: its grid, the attractor slots of a cell, its axes
+/// (x, y) and the metres per g₀ of a cell at (x, y) (1 without a probe).
+pub(crate) struct ChartView<'a> {
+    /// The chart's values and options.
+    pub(crate) spec: &'a ChartSpec,
+    /// Attractor slots per cell of its arrays.
+    pub(crate) slots: usize,
+    /// Its axes, x then y.
+    pub(crate) axes: (ChartAxis<'a>, ChartAxis<'a>),
+    /// The length unit of the cell at (x, y).
+    pub(crate) length: Box<dyn Fn(f64, f64) -> f64 + 'a>,
+}
+
 /// The label of a chart axis: symbol, name and unit.
-fn axis_label(name: &str) -> String {
-    let symbol = parameter(name).map_or(name, |p| p.symbol);
+fn axis_label(axis: ChartAxis<'_>) -> String {
+    let (symbol, name) = (axis.symbol, axis.name);
     let head = if symbol == name {
         name.to_string()
     } else {
         format!("{symbol} {name}")
     };
-    match axis_unit(name) {
+    match axis.unit {
         "1" => head,
         unit => format!("{head} ({unit})"),
     }
@@ -70,14 +82,14 @@ fn diverging(v: f64, m: f64) -> Rgb {
 /// A chart's map of `cells` with `legend` over its axes.
 fn chart_map(
     a: &ChartArrays,
-    chart: &Chart,
+    chart: &ChartView<'_>,
     title: &str,
     cells: Vec<Option<Rgb>>,
     legend: Vec<(String, Rgb)>,
 ) -> Plot {
     Plot::Cells(CellMap {
         title: title.into(),
-        labels: (axis_label(chart.model.x), axis_label(chart.model.y)),
+        labels: (axis_label(chart.axes.0), axis_label(chart.axes.1)),
         x: a.x.clone(),
         y: a.y.clone(),
         cells,
@@ -88,7 +100,7 @@ fn chart_map(
 
 /// The three maps of a chart: the dominant attractor's period class, its λ₁ where it is
 /// nonperiodic, the number of coexisting attractors.
-fn chart_maps(s: &mut Presentation, chart: &Chart, a: &ChartArrays) {
+fn chart_maps(s: &mut Presentation, chart: &ChartView<'_>, a: &ChartArrays) {
     // period of the dominant attractor
     let mut classes: Vec<(usize, &str)> = Vec::new();
     let cells: Vec<Option<Rgb>> = a
@@ -165,19 +177,20 @@ fn chart_maps(s: &mut Presentation, chart: &Chart, a: &ChartArrays) {
 /// A finished chart: `chart.csv` (every attractor of every cell), `chart.nc` (the arrays of
 /// [`ChartArrays`]), the maps `chart-period`, `chart-lyapunov`, `chart-attractors`, and the
 /// summary (the cells with coexisting attractors and without any).
-pub(crate) fn chart(chart: &Chart, cells: &[ChartCell]) -> Presentation {
+pub(crate) fn chart(chart: &ChartView<'_>, cells: &[ChartCell]) -> Presentation {
     let mut s = Presentation::default();
     let mut text = CSV_HEADER.join(",");
     text.push('\n');
     for c in cells {
-        for line in csv_lines(chart, c) {
+        for line in csv_lines((chart.length)(c.x, c.y), c) {
             text.push_str(&line);
             text.push('\n');
         }
     }
     s.text("chart.csv", text);
-    let arrays = ChartArrays::new(chart, cells);
-    s.dataset("chart.nc", arrays.layout(chart.model.x, chart.model.y));
+    let size = (chart.spec.x.len(), chart.spec.y.len());
+    let arrays = ChartArrays::region_of((chart.spec, chart.slots), (0, 0), size, cells);
+    s.dataset("chart.nc", arrays.layout_over(chart.axes.0, chart.axes.1));
     chart_maps(&mut s, chart, &arrays);
     let multi = cells.iter().filter(|c| c.attractors.len() > 1).count();
     let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();
@@ -185,8 +198,8 @@ pub(crate) fn chart(chart: &Chart, cells: &[ChartCell]) -> Presentation {
         "chart of {} × {} cells over {} × {}: {} with coexisting attractors, {} without any",
         chart.spec.x.len(),
         chart.spec.y.len(),
-        chart.model.x,
-        chart.model.y,
+        chart.axes.0.name,
+        chart.axes.1.name,
         multi,
         empty,
     ));
