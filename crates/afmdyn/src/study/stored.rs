@@ -14,23 +14,24 @@ use super::global_continuation::{continuation_store, ContinuationStudy};
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
 use super::sweep::SweepStudy;
-use super::task_store::{StoredTasks, TaskStore};
-use super::{execute, MemoryStore, Observer, Study, StudyError};
+use super::sweep::{SweepCheckpoint, SweepRows};
+use super::task_store::{Lines, TaskStore};
+use super::{execute, MemoryStore, Observer, Resumes, Study, StudyError};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::analysis::stepped::SteppedCurve;
 use crate::error::SimError;
 use crate::request::chart::Chart;
 use crate::request::checkpoint::CheckpointError;
-use crate::request::checkpoint_file::each_row;
+use crate::request::checkpoint_file::{each_row, final_csv, final_rows, write_npy};
 use crate::request::image_job::{ImageJob, ImageOutput};
 use crate::request::image_scan::ScanStudy;
 use crate::request::named::{self, Datasets, Outcome};
 use crate::request::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, SweepTally};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
+use crate::request::GlobalContinuationRequest;
 use crate::request::{Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock};
-use crate::request::{FileCheckpoint, GlobalContinuationRequest, MemoryCheckpoint};
 use crate::request::{Resolved, ResonanceRequest};
 use serde::de::{DeserializeOwned, Deserializer};
 use serde::{Deserialize, Serialize};
@@ -82,13 +83,13 @@ impl Storage<'_> {
     fn records<S, R>(
         &self,
         study: &S,
-        open: fn(&DirLock) -> TaskStore<'_, R>,
+        open: fn(&DirLock) -> TaskStore<'_, Lines<R>>,
         threads: Option<usize>,
         progress: &Progress,
     ) -> Result<Vec<(usize, R)>, StudyError>
     where
         S: Study<Record = (usize, R)>,
-        S::Done: StoredTasks<R>,
+        S::Done: Resumes<(usize, R)>,
         R: Serialize + DeserializeOwned + Clone + Send,
     {
         let watch = Watch {
@@ -113,8 +114,8 @@ impl Storage<'_> {
 /// A sweep run: into the directory's checkpoint (its rows in its `bifurcation.csv`), or into
 /// memory.
 pub(crate) enum Swept<'a> {
-    /// The directory's checkpoint, finished.
-    Stored(FileCheckpoint<'a>),
+    /// The directory of the finished checkpoint.
+    Stored(&'a std::path::Path),
     /// The records.
     Memory(Vec<SweepRecord>),
 }
@@ -137,14 +138,14 @@ impl<'a> Storage<'a> {
         };
         match self.lock {
             Some(lock) => {
-                let mut s = FileCheckpoint::new(lock);
+                let mut s: SweepCheckpoint<'_> = TaskStore::new(lock, SweepRows);
                 execute(study, &mut s, self.resume, threads, &watch)?;
-                Ok(Swept::Stored(s))
+                Ok(Swept::Stored(lock.path()))
             }
             None => {
-                let mut s = MemoryCheckpoint::default();
+                let mut s = MemoryStore::default();
                 execute(study, &mut s, false, threads, &watch)?;
-                Ok(Swept::Memory(s.into_records()))
+                Ok(Swept::Memory(s.records.into_iter().flatten().collect()))
             }
         }
     }
@@ -367,17 +368,17 @@ impl Resumable for SweepInto {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<SweepFiles, StudyError> {
-        let Swept::Stored(store) = storage.sweep(study, self.0.threads, progress)? else {
+        let Swept::Stored(dir) = storage.sweep(study, self.0.threads, progress)? else {
             return Err(SimError::File(NO_DIRECTORY.into()).into());
         };
         // derived from the finished rows, streamed
-        let csv = store.final_csv();
+        let csv = final_csv(dir);
         let mut tally = SweepTally::default();
         each_row(&csv, &mut |r| -> Result<(), CheckpointError> {
             tally.add_row(SweepRow::from_csv(r));
             Ok(())
         })?;
-        let npy = store.write_npy(self.0.param).map_err(SimError::from)?;
+        let npy = write_npy(dir, self.0.param).map_err(SimError::from)?;
         Ok(SweepFiles {
             spec: study.spec.clone(),
             tally,
@@ -519,7 +520,7 @@ impl Prepared for Sweep {
             abort_after: None,
         };
         let records = match storage.sweep(&study, self.request.threads, progress)? {
-            Swept::Stored(store) => store.records()?,
+            Swept::Stored(dir) => final_rows(dir)?,
             Swept::Memory(records) => records,
         };
         if let Some(e) = every_point_failed(&records) {
