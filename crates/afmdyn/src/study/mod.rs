@@ -7,11 +7,13 @@
 //!   sweep's coarse pass before its chain segments, a chart's tiles) stays the study's own.
 //! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
 //!   appends a finished task, and finishes atomically (the files in the one order); the file
-//!   stores lock their directory for one run at a time
-//!   (`crate::request::checkpoint_file::FileCheckpoint` for sweeps; `task_store::TaskStore`,
-//!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `chart_store`; a PI-scanned image's lines, `scan_store`); `MemoryStore` keeps the tasks
-//!   in memory.
+//!   stores lock their directory for one run at a time. Two stores serve every study: the
+//!   file store `task_store::TaskStore` (feature `files`), its records written by a codec —
+//!   JSON lines for a study of numbered tasks whose records serialize (the chart's
+//!   `chart_store`; a PI-scanned image's lines, `scan_store`), the checkpoint's CSV rows for
+//!   a sweep (`sweep::SweepRows`); and [`MemoryStore`], which keeps the tasks in memory
+//!   with the same ledger (a resume of the same request goes on, of another is refused). What
+//!   a resume skips is gathered from the stored records ([`Resumes`]).
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   `crate::request::limits::check_threads`), runs the study, appends each finished task
@@ -27,8 +29,7 @@
 //!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance curve's
 //!   points, one chain through both sweeps, its store `stepped::curve_store`) and
 //!   `peakforce` (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
-//!   sweep's points, its branches continued across them, stored by the request layer's
-//!   checkpoints). A chain's resume reads its stored records back (its next task starts from
+//!   sweep's points, its branches continued across them, stored in its checkpoint). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,

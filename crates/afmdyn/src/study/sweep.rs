@@ -2,7 +2,7 @@
 //! one way), its record the point's rows ([`SweepRecord`]), what a resume skips the stored
 //! points with the chains' last states ([`Resume`]). Its stores are every study's: in memory
 //! ([`super::MemoryStore`]), or with the `files` feature its checkpoint's CSV in a directory
-//! (a `TaskStore` written by [`SweepRows`]).
+//! (a `TaskStore` written by `SweepRows`).
 
 use super::{Resumes, Study};
 use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};

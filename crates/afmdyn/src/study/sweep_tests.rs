@@ -8,7 +8,7 @@ use crate::analysis::progress::Progress;
 use crate::params::Params;
 use crate::request::checkpoint::*;
 use crate::request::sweep::SweepRecord;
-use crate::request::sweep::{fingerprint, order_key, PointStatus, HEADER};
+use crate::request::sweep::{order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
 use crate::study::{execute, MemoryStore, Opened, Store, StudyError};
 use std::collections::HashSet;
@@ -73,17 +73,17 @@ fn resume_into<C: Store<SweepStudy>>(
 }
 
 /// A sweep's store in memory.
-type MemoryCheckpoint = MemoryStore<Vec<SweepRecord>>;
+type SweepMemory = MemoryStore<Vec<SweepRecord>>;
 
 /// The records of a store, point after point.
-fn flat(store: MemoryCheckpoint) -> Vec<SweepRecord> {
+fn flat(store: SweepMemory) -> Vec<SweepRecord> {
     store.records.into_iter().flatten().collect()
 }
 
 /// An uninterrupted sweep: the store before `finish` (points in the order they finished) and
 /// the finished records.
-fn uninterrupted(r: &BifurcationRequest) -> (MemoryCheckpoint, Vec<SweepRecord>) {
-    let mut store = MemoryCheckpoint::default();
+fn uninterrupted(r: &BifurcationRequest) -> (SweepMemory, Vec<SweepRecord>) {
+    let mut store = SweepMemory::default();
     let s = SweepStudy::new(r, spec(r));
     let Opened::Run(resume) = Store::open(&mut store, &s, false).unwrap() else {
         panic!("a new sweep runs")
@@ -162,7 +162,7 @@ fn a_resume_computes_exactly_the_points_not_stored() {
     let total = unfinished.records.len();
     for k in [0, 1, total / 2, total - 1, total] {
         // interrupted after k points, in the order they finished
-        let mut store = MemoryCheckpoint {
+        let mut store = SweepMemory {
             records: unfinished.records[..k].to_vec(),
             ..unfinished.clone()
         };
@@ -189,7 +189,7 @@ fn a_resume_computes_exactly_the_points_not_stored() {
 #[test]
 fn a_finished_store_computes_nothing() {
     let r = request();
-    let mut store = MemoryCheckpoint::default();
+    let mut store = SweepMemory::default();
     assert_eq!(
         resume_into(&mut store, &r).unwrap().len(),
         point_count(&spec(&r))
@@ -246,7 +246,7 @@ fn another_request_is_refused_naming_the_first_field_that_differs() {
 #[test]
 fn records_without_a_ledger_are_not_resumed() {
     let (unfinished, _) = uninterrupted(&request());
-    let mut store = MemoryCheckpoint {
+    let mut store = SweepMemory {
         ledger: None,
         ..unfinished
     };
@@ -261,6 +261,7 @@ fn records_without_a_ledger_are_not_resumed() {
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     use crate::io::dir_lock::DirLock;
     use crate::request::checkpoint_file::{final_rows, LEDGER, PARTIAL_CSV};
+    use crate::request::sweep::fingerprint;
     use crate::study::task_store::TaskStore;
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);
