@@ -21,8 +21,7 @@
 
 use super::basins::BasinStudy;
 use super::stored::sweep_outcome;
-use super::sweep::{SweepCheckpoint, SweepRows};
-use super::task_store::TaskStore;
+use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
 use super::{Opened, StudyError};
 use crate::analysis::am_loop::ScanLine;
@@ -382,7 +381,7 @@ struct SweepStore {
 impl SweepStore {
     /// The checkpoint in the store's directory.
     fn checkpoint(&self) -> SweepCheckpoint<'_> {
-        TaskStore::new(&self.lock, SweepRows)
+        sweep_checkpoint(&self.lock)
     }
 }
 

@@ -13,9 +13,8 @@ use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
-use super::sweep::SweepStudy;
-use super::sweep::{SweepCheckpoint, SweepRows};
-use super::task_store::{Lines, TaskStore};
+use super::sweep::{sweep_checkpoint, SweepStudy};
+use super::task_store::{Codec, Lines, TaskStore};
 use super::{execute, MemoryStore, Observer, Resumes, Study, StudyError};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
@@ -74,9 +73,52 @@ impl Observer for Watch<'_> {
     }
 }
 
-impl Storage<'_> {
-    /// Run `study` (on `threads`, counting in `progress`) into the task store `open` makes of
-    /// the directory, or into memory: its records.
+/// Where a study ran: the finished file store of the directory, or its records in memory.
+enum Ran<'a, C: Codec> {
+    /// The directory's store.
+    Stored(TaskStore<'a, C>),
+    /// The records.
+    Memory(Vec<C::Record>),
+}
+
+impl<'a> Storage<'a> {
+    /// Run `study` (on `threads`, counting in `progress`) into the store `open` makes of the
+    /// directory, or into memory.
+    ///
+    /// # Errors
+    /// The store's and the study's.
+    fn run<S, C>(
+        &self,
+        study: &S,
+        open: impl FnOnce(&'a DirLock) -> TaskStore<'a, C>,
+        threads: Option<usize>,
+        progress: &Progress,
+    ) -> Result<Ran<'a, C>, StudyError>
+    where
+        S: Study<Record = C::Record>,
+        S::Done: Resumes<C::Record>,
+        C: Codec + Send,
+        C::Record: Send,
+    {
+        let watch = Watch {
+            progress,
+            abort_after: self.abort_after,
+        };
+        match self.lock {
+            Some(lock) => {
+                let mut store = open(lock);
+                execute(study, &mut store, self.resume, threads, &watch)?;
+                Ok(Ran::Stored(store))
+            }
+            None => {
+                let mut store = MemoryStore::default();
+                execute(study, &mut store, false, threads, &watch)?;
+                Ok(Ran::Memory(store.records))
+            }
+        }
+    }
+
+    /// Run `study` as [`Storage::run`] into the JSON-lines store `open` makes: its records.
     ///
     /// # Errors
     /// The store's and the study's.
@@ -92,62 +134,10 @@ impl Storage<'_> {
         S::Done: Resumes<(usize, R)>,
         R: Serialize + DeserializeOwned + Clone + Send,
     {
-        let watch = Watch {
-            progress,
-            abort_after: self.abort_after,
-        };
-        match self.lock {
-            Some(lock) => {
-                let mut store = open(lock);
-                execute(study, &mut store, self.resume, threads, &watch)?;
-                Ok(store.records()?)
-            }
-            None => {
-                let mut store = MemoryStore::default();
-                execute(study, &mut store, false, threads, &watch)?;
-                Ok(store.records)
-            }
-        }
-    }
-}
-
-/// A sweep run: into the directory's checkpoint (its rows in its `bifurcation.csv`), or into
-/// memory.
-pub(crate) enum Swept<'a> {
-    /// The directory of the finished checkpoint.
-    Stored(&'a std::path::Path),
-    /// The records.
-    Memory(Vec<SweepRecord>),
-}
-
-impl<'a> Storage<'a> {
-    /// Run the sweep `study` (on `threads`, counting in `progress`) into the directory's
-    /// checkpoint, or into memory.
-    ///
-    /// # Errors
-    /// The store's and the study's.
-    pub(crate) fn sweep(
-        &self,
-        study: &SweepStudy,
-        threads: Option<usize>,
-        progress: &Progress,
-    ) -> Result<Swept<'a>, StudyError> {
-        let watch = Watch {
-            progress,
-            abort_after: self.abort_after,
-        };
-        match self.lock {
-            Some(lock) => {
-                let mut s: SweepCheckpoint<'_> = TaskStore::new(lock, SweepRows);
-                execute(study, &mut s, self.resume, threads, &watch)?;
-                Ok(Swept::Stored(lock.path()))
-            }
-            None => {
-                let mut s = MemoryStore::default();
-                execute(study, &mut s, false, threads, &watch)?;
-                Ok(Swept::Memory(s.records.into_iter().flatten().collect()))
-            }
-        }
+        Ok(match self.run(study, open, threads, progress)? {
+            Ran::Stored(mut store) => store.records()?,
+            Ran::Memory(records) => records,
+        })
     }
 }
 
@@ -368,10 +358,12 @@ impl Resumable for SweepInto {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<SweepFiles, StudyError> {
-        let Swept::Stored(dir) = storage.sweep(study, self.0.threads, progress)? else {
+        let sweep = storage.run(study, sweep_checkpoint, self.0.threads, progress)?;
+        let Ran::Stored(store) = sweep else {
             return Err(SimError::File(NO_DIRECTORY.into()).into());
         };
         // derived from the finished rows, streamed
+        let dir = store.dir();
         let csv = final_csv(dir);
         let mut tally = SweepTally::default();
         each_row(&csv, &mut |r| -> Result<(), CheckpointError> {
@@ -519,9 +511,9 @@ impl Prepared for Sweep {
             resume,
             abort_after: None,
         };
-        let records = match storage.sweep(&study, self.request.threads, progress)? {
-            Swept::Stored(dir) => final_rows(dir)?,
-            Swept::Memory(records) => records,
+        let records = match storage.run(&study, sweep_checkpoint, self.request.threads, progress)? {
+            Ran::Stored(store) => final_rows(store.dir())?,
+            Ran::Memory(points) => points.into_iter().flatten().collect(),
         };
         if let Some(e) = every_point_failed(&records) {
             return Err(e.into());

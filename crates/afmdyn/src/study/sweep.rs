@@ -202,9 +202,15 @@ impl super::task_store::Codec for SweepRows {
     }
 }
 
-#[cfg(feature = "files")]
 /// A sweep's checkpoint in the directory a lock holds.
+#[cfg(feature = "files")]
 pub(crate) type SweepCheckpoint<'a> = super::task_store::TaskStore<'a, SweepRows>;
+
+/// The sweep's checkpoint in the directory `lock` holds.
+#[cfg(feature = "files")]
+pub(crate) fn sweep_checkpoint(lock: &crate::io::dir_lock::DirLock) -> SweepCheckpoint<'_> {
+    super::task_store::TaskStore::new(lock, SweepRows)
+}
 
 #[cfg(test)]
 #[path = "sweep_tests.rs"]
