@@ -5,11 +5,10 @@
 //! further points is stored — a resumed run of the same sweep, so the chunks together are the
 //! one uninterrupted sweep (each chain goes on from its last stored state).
 
-use afmdyn::request::checkpoint::MemoryCheckpoint;
 use afmdyn::request::sweep::SweepRecord;
 use afmdyn::request::BifurcationRequest;
 use afmdyn::study::sweep::SweepStudy;
-use afmdyn::study::{execute, Observer, Outcome, StudyError};
+use afmdyn::study::{execute, MemoryStore, Observer, Outcome, StudyError};
 use serde_json::{json, Value};
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -73,7 +72,7 @@ pub fn columns() -> Value {
 /// A bifurcation sweep computed chunk by chunk (module docs).
 pub struct BifurcationSession {
     study: SweepStudy,
-    store: MemoryCheckpoint,
+    store: MemoryStore<Vec<SweepRecord>>,
     /// The points handed out: (value index, branch).
     sent: HashSet<(usize, String)>,
     total: usize,
@@ -93,7 +92,7 @@ impl BifurcationSession {
         let total = afmdyn::request::checkpoint::point_count(&spec);
         Ok(BifurcationSession {
             study: SweepStudy::new(&request, spec),
-            store: MemoryCheckpoint::default(),
+            store: MemoryStore::default(),
             sent: HashSet::new(),
             total,
             finished: false,
@@ -132,7 +131,7 @@ impl BifurcationSession {
             }
         }
         let mut rows = Vec::new();
-        for p in &self.store.points {
+        for p in &self.store.records {
             let Some(first) = p.first() else { continue };
             if self.sent.insert((first.index, first.branch.to_string())) {
                 rows.extend(p.iter().map(row));

@@ -15,8 +15,8 @@
 //! The layout is the command line's `afmdyn bifurcation --out DIR`; Python's
 //! `afmdyn.bifurcation(store=DIR)` uses the same, so either resumes the other's sweep.
 
-use super::checkpoint::{end_state, Checkpoint, CheckpointError, DonePoint, Ledger, StoreStatus};
-use super::dir_lock::{partial_path, DirLock};
+use super::checkpoint::CheckpointError;
+use super::dir_lock::partial_path;
 use super::sweep::{branch_code, status_code, SweepRecord, HEADER, NUMERIC_COLUMNS};
 use super::sweep::{COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT, COL_POINTS, COL_STATUS};
 use super::sweep::{COL_TAU, COL_VALUE, COL_W_TIP, COL_X_MAX};
@@ -24,9 +24,9 @@ use crate::analysis::bifurcation::Branch;
 use crate::io::input::{open_existing, refusal, Bounded, InputFileError, InputKind};
 use crate::layout::files::{io_error, Column, FileError, NpyStream};
 use crate::params::SweepParam;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::collections::HashSet;
-use std::fs::{self, File, OpenOptions};
+use std::fs::{self, File};
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -135,15 +135,6 @@ fn corrupt(path: &Path, message: String) -> CheckpointError {
         path: path.display().to_string(),
         message,
     }
-}
-
-/// A sweep's checkpoint in a directory (see the module), which the caller holds locked.
-#[derive(Debug)]
-pub(crate) struct FileCheckpoint<'a> {
-    /// The lock the store is written under (held for the checkpoint's lifetime).
-    _lock: &'a DirLock,
-    dir: PathBuf,
-    writer: Option<BufWriter<File>>,
 }
 
 /// Each row of the store's CSV `path` (its finished rows), read through the bounded reader: a
@@ -343,217 +334,134 @@ fn groups(path: &Path) -> Result<Vec<Group>, CheckpointError> {
     Ok(groups)
 }
 
-impl<'a> FileCheckpoint<'a> {
-    /// The store in the directory `lock` holds ([`DirLock::acquire`] creates and locks it, so
-    /// that no two runs write one store).
-    pub(crate) fn new(lock: &'a DirLock) -> FileCheckpoint<'a> {
-        FileCheckpoint {
-            _lock: lock,
-            dir: lock.path().to_path_buf(),
-            writer: None,
-        }
-    }
-
-    /// The finished rows, `DIR/bifurcation.csv`.
-    pub(crate) fn final_csv(&self) -> PathBuf {
-        self.dir.join(FINAL_CSV)
-    }
-
-    fn partial(&self) -> PathBuf {
-        self.dir.join(PARTIAL_CSV)
-    }
-
-    /// Write `DIR/bifurcation.npy` and its `.npy.json` from the finished rows
-    /// ([`Self::final_csv`], streamed): the columns [`NUMERIC_COLUMNS`], the branch and the
-    /// status as their codes ([`branch_code`], [`status_code`]), an empty cell (a failed
-    /// point's numbers) as NaN; `param` names the value's column. Returns the path.
-    ///
-    /// # Errors
-    /// [`FileError`] naming the file that cannot be read or written.
-    pub(crate) fn write_npy(&self, param: SweepParam) -> Result<PathBuf, FileError> {
-        let (csv_path, npy) = (self.final_csv(), self.dir.join("bifurcation.npy"));
-        let rd = |e: csv::Error| io_error("read", &csv_path, e);
-        let file = crate::io::open(&csv_path, InputKind::Store)
-            .map_err(|e| io_error("read", &csv_path, e))?;
-        let mut reader = csv::Reader::from_reader(file);
-        let columns = NUMERIC_COLUMNS
-            .iter()
-            .map(|c| match c.name {
-                "value" => Column::new(c.name, c.unit, format!("{} ({})", c.meaning, param.name())),
-                _ => Column::new(c.name, c.unit, c.meaning),
-            })
-            .collect();
-        let mut s = NpyStream::create(&npy, columns)?;
-        for r in reader.records() {
-            let r = r.map_err(rd)?;
-            let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
-            let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
-            s.push(&[
-                num(COL_VALUE),
-                num(COL_INDEX),
-                branch_code(branch),
-                status_code(&r[COL_STATUS], &r[COL_PERIOD]),
-                num(COL_POINT),
-                num(COL_TAU),
-                num(COL_TAU + 1),
-                num(COL_W_TIP),
-                num(COL_X_MAX),
-                num(COL_X_MAX + 1),
-                num(COL_X_MAX + 2),
-                num(COL_X_MAX + 3),
-            ])?;
-        }
-        s.finish()?;
-        Ok(npy)
-    }
-
-    fn ledger_path(&self) -> PathBuf {
-        self.dir.join(LEDGER)
-    }
-
-    fn write_ledger(&self, fingerprint: &Value, finished: bool) -> Result<(), CheckpointError> {
-        let doc = json!({ "args": fingerprint, "finished": finished });
-        let text = serde_json::to_string_pretty(&doc).unwrap_or_default() + "\n";
-        write_atomic(&self.ledger_path(), text.as_bytes())
-    }
-
-    /// The finished rows, read back in their order.
-    ///
-    /// # Errors
-    /// [`CheckpointError::Io`], or [`CheckpointError::Corrupt`] naming the line that cannot
-    /// be read.
-    pub(crate) fn records(&self) -> Result<Vec<SweepRecord>, CheckpointError> {
-        let path = self.final_csv();
-        let file = open_store(&path, InputKind::Store)?.ok_or_else(|| CheckpointError::Io {
-            action: "read",
-            path: path.display().to_string(),
-            message: "No such file or directory".into(),
-        })?;
-        BufReader::new(file)
-            .lines()
-            .enumerate()
-            .skip(1)
-            .map(|(i, l)| {
-                let l = l.map_err(|e| read_failed(&path, e))?;
-                SweepRecord::parse_csv(&l).map_err(|message| CheckpointError::Corrupt {
-                    path: path.display().to_string(),
-                    message: format!("line {}: {message}", i + 1),
-                })
-            })
-            .collect()
-    }
+/// The finished rows of the store in `dir`, `DIR/bifurcation.csv`.
+pub(crate) fn final_csv(dir: &Path) -> PathBuf {
+    dir.join(FINAL_CSV)
 }
 
-impl Checkpoint for FileCheckpoint<'_> {
-    fn status(&mut self) -> Result<StoreStatus, CheckpointError> {
-        let ledger = read_ledger(&self.ledger_path())?.map(|doc| Ledger {
-            fingerprint: doc["args"].clone(),
-            finished: doc["finished"] == json!(true),
-        });
-        Ok(StoreStatus {
-            ledger,
-            partial: self.partial().exists(),
-            complete: self.final_csv().exists(),
-        })
-    }
-
-    fn begin(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
-        self.writer = None;
-        // the old rows go first, then the ledger names the new run
-        let partial = self.partial();
-        if partial.exists() {
-            fs::remove_file(&partial).map_err(io("remove", &partial))?;
-        }
-        self.write_ledger(fingerprint, false)?;
-        let mut f = File::create(&partial).map_err(io("create", &partial))?;
-        writeln!(f, "{}", partial_header()).map_err(io("write", &partial))
-    }
-
-    fn done(&mut self) -> Result<Vec<DonePoint>, CheckpointError> {
-        self.writer = None;
-        let partial = self.partial();
-        let groups = groups(&partial)?;
-        let mut text = partial_header() + "\n";
-        let mut done = Vec::with_capacity(groups.len());
-        for ((index, branch), lines) in groups {
-            let state = lines
-                .last()
-                .and_then(|l| SweepRecord::parse_csv(l).ok())
-                .and_then(|r| end_state(std::slice::from_ref(&r)));
-            done.push(DonePoint {
-                index,
-                branch,
-                state,
-            });
-            for l in lines {
-                text.push_str(&sealed(&l));
-                text.push('\n');
-            }
-        }
-        // keep only the complete points, so that new rows follow a whole line
-        write_atomic(&partial, text.as_bytes())?;
-        Ok(done)
-    }
-
-    fn append(&mut self, point: &[SweepRecord]) -> Result<(), CheckpointError> {
-        let partial = self.partial();
-        if self.writer.is_none() {
-            let file = OpenOptions::new()
-                .append(true)
-                .open(&partial)
-                .map_err(io("open", &partial))?;
-            self.writer = Some(BufWriter::new(file));
-        }
-        let mut text = String::new();
-        for r in point {
-            text.push_str(&sealed(&r.csv_line()));
+/// Every complete point of the checkpoint `path` handed to `each` (its rows, in file order;
+/// see [`groups`]), the file cut back to them so that new rows follow a whole line.
+///
+/// # Errors
+/// As [`groups`]; [`CheckpointError::Corrupt`] for a row that cannot be read.
+pub(crate) fn read_points(
+    path: &Path,
+    each: &mut dyn FnMut(Vec<SweepRecord>),
+) -> Result<(), CheckpointError> {
+    let groups = groups(path)?;
+    let mut text = partial_header() + "\n";
+    let mut points = Vec::with_capacity(groups.len());
+    for (_, lines) in groups {
+        let point = (lines.iter().map(|l| SweepRecord::parse_csv(l)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|message| corrupt(path, format!("{message}; {START_OVER}")))?;
+        points.push(point);
+        for l in lines {
+            text.push_str(&sealed(&l));
             text.push('\n');
         }
-        let w = self.writer.as_mut().ok_or_else(|| CheckpointError::Io {
-            action: "open",
-            path: partial.display().to_string(),
-            message: "no writer".into(),
-        })?;
-        w.write_all(text.as_bytes())
-            .and_then(|_| w.flush())
-            .map_err(io("write", &partial))
     }
+    // keep only the complete points
+    write_atomic(path, text.as_bytes())?;
+    points.into_iter().for_each(each);
+    Ok(())
+}
 
-    /// Sort the points by key into `bifurcation.csv` (their rows checked and without their
-    /// checksums), remove the partial rows, mark the ledger finished.
-    fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
-        let partial = self.partial();
-        if let Some(mut w) = self.writer.take() {
-            w.flush().map_err(io("write", &partial))?;
-        }
-        let final_csv = self.final_csv();
-        let mut groups = groups(&partial)?;
-        groups.sort_by_key(|g| g.0);
-        let sorted = self.dir.join(SORTED_CSV);
-        {
-            let wr = io("write", &final_csv);
-            let mut out = BufWriter::new(File::create(&sorted).map_err(io("write", &final_csv))?);
-            let mut copy = || -> std::io::Result<()> {
-                writeln!(out, "{}", HEADER.join(","))?;
-                for (_, lines) in &groups {
-                    for l in lines {
-                        writeln!(out, "{l}")?;
-                    }
+/// Sort the points of the finished sweep in `dir` by key into `bifurcation.csv` (their rows
+/// checked and without their checksums) and remove the checkpoint's rows.
+///
+/// # Errors
+/// As [`groups`]; [`CheckpointError::Io`].
+pub(crate) fn sort_into_final(dir: &Path) -> Result<(), CheckpointError> {
+    let (partial, final_csv) = (dir.join(PARTIAL_CSV), final_csv(dir));
+    let mut groups = groups(&partial)?;
+    groups.sort_by_key(|g| g.0);
+    let sorted = dir.join(SORTED_CSV);
+    {
+        let wr = io("write", &final_csv);
+        let mut out = BufWriter::new(File::create(&sorted).map_err(io("write", &final_csv))?);
+        let mut copy = || -> std::io::Result<()> {
+            writeln!(out, "{}", HEADER.join(","))?;
+            for (_, lines) in &groups {
+                for l in lines {
+                    writeln!(out, "{l}")?;
                 }
-                out.flush()?;
-                out.get_ref().sync_all()
-            };
-            copy().map_err(wr)?;
-        }
-        fs::rename(&sorted, &final_csv).map_err(io("finish", &final_csv))?;
-        fs::remove_file(&partial).map_err(io("remove", &partial))?;
-        self.write_ledger(fingerprint, true)
+            }
+            out.flush()?;
+            out.get_ref().sync_all()
+        };
+        copy().map_err(wr)?;
     }
+    fs::rename(&sorted, &final_csv).map_err(io("finish", &final_csv))?;
+    fs::remove_file(&partial).map_err(io("remove", &partial))
+}
 
-    fn names(&self) -> (String, String) {
-        (
-            self.dir.display().to_string(),
-            self.ledger_path().display().to_string(),
-        )
+/// Write `DIR/bifurcation.npy` and its `.npy.json` from the finished rows ([`final_csv`],
+/// streamed): the columns [`NUMERIC_COLUMNS`], the branch and the status as their codes
+/// ([`branch_code`], [`status_code`]), an empty cell (a failed point's numbers) as NaN;
+/// `param` names the value's column. Returns the path.
+///
+/// # Errors
+/// [`FileError`] naming the file that cannot be read or written.
+pub(crate) fn write_npy(dir: &Path, param: SweepParam) -> Result<PathBuf, FileError> {
+    let (csv_path, npy) = (final_csv(dir), dir.join("bifurcation.npy"));
+    let rd = |e: csv::Error| io_error("read", &csv_path, e);
+    let file =
+        crate::io::open(&csv_path, InputKind::Store).map_err(|e| io_error("read", &csv_path, e))?;
+    let mut reader = csv::Reader::from_reader(file);
+    let columns = NUMERIC_COLUMNS
+        .iter()
+        .map(|c| match c.name {
+            "value" => Column::new(c.name, c.unit, format!("{} ({})", c.meaning, param.name())),
+            _ => Column::new(c.name, c.unit, c.meaning),
+        })
+        .collect();
+    let mut s = NpyStream::create(&npy, columns)?;
+    for r in reader.records() {
+        let r = r.map_err(rd)?;
+        let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
+        let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
+        s.push(&[
+            num(COL_VALUE),
+            num(COL_INDEX),
+            branch_code(branch),
+            status_code(&r[COL_STATUS], &r[COL_PERIOD]),
+            num(COL_POINT),
+            num(COL_TAU),
+            num(COL_TAU + 1),
+            num(COL_W_TIP),
+            num(COL_X_MAX),
+            num(COL_X_MAX + 1),
+            num(COL_X_MAX + 2),
+            num(COL_X_MAX + 3),
+        ])?;
     }
+    s.finish()?;
+    Ok(npy)
+}
+
+/// The finished rows of the store in `dir`, read back in their order.
+///
+/// # Errors
+/// [`CheckpointError::Io`], or [`CheckpointError::Corrupt`] naming the line that cannot
+/// be read.
+pub(crate) fn final_rows(dir: &Path) -> Result<Vec<SweepRecord>, CheckpointError> {
+    let path = final_csv(dir);
+    let file = open_store(&path, InputKind::Store)?.ok_or_else(|| CheckpointError::Io {
+        action: "read",
+        path: path.display().to_string(),
+        message: "No such file or directory".into(),
+    })?;
+    BufReader::new(file)
+        .lines()
+        .enumerate()
+        .skip(1)
+        .map(|(i, l)| {
+            let l = l.map_err(|e| read_failed(&path, e))?;
+            SweepRecord::parse_csv(&l).map_err(|message| CheckpointError::Corrupt {
+                path: path.display().to_string(),
+                message: format!("line {}: {message}", i + 1),
+            })
+        })
+        .collect()
 }

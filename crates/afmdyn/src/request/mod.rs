@@ -20,9 +20,9 @@
 //!   a request's cost ([`limits::Cost`]), which `costs` estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
-//! - [`checkpoint`]: resumable sweeps: the `Checkpoint` a store implements, in memory or
-//!   (feature `files`) in a directory (`checkpoint_file`), locked for one run at a time
-//!   ([`crate::io::dir_lock`]).
+//! - [`checkpoint`]: what every study's store shares (its errors and ledger); with the feature
+//!   `files`, the CSV of a sweep's checkpoint (`checkpoint_file`), in a directory locked for
+//!   one run at a time ([`crate::io::dir_lock`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
 //! the library's parameter (`samples_per_period`) and a front end respells them
@@ -79,10 +79,6 @@ pub use analyses::{
 };
 pub use basins::{BasinArrays, BasinsRequest};
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
-#[cfg(feature = "files")]
-pub(crate) use checkpoint::MemoryCheckpoint;
-#[cfg(feature = "files")]
-pub(crate) use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};

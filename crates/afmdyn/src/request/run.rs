@@ -12,7 +12,7 @@
 //! `crate::trajectory::chunked::record_chunked`, its series' bytes held against the files'
 //! budget, [`crate::request::analyses::SimulateSpan`]), and `bifurcation`, whose `execute` is
 //! the in-memory sweep; a front end that runs the sweep resumably into a store of its own
-//! ([`crate::study::sweep::SweepStudy`] into a `crate::request::Checkpoint`) checks its cost
+//! ([`crate::study::sweep::SweepStudy`] into its checkpoint) checks its cost
 //! first by [`admit`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count

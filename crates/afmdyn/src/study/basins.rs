@@ -146,7 +146,7 @@ impl Analysis for BasinsRequest {
 /// [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
 pub(crate) mod store {
-    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
+    use super::super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
     use crate::analysis::basins::BasinRow;
     use crate::io::dir_lock::DirLock;
 
@@ -160,11 +160,11 @@ pub(crate) mod store {
     };
 
     /// A basin map's store: its rows by task.
-    pub(crate) type BasinStore<'a> = TaskStore<'a, BasinRow>;
+    pub(crate) type BasinStore<'a> = TaskStore<'a, Lines<BasinRow>>;
 
     /// The basin store of the directory `lock` holds.
     pub(crate) fn basin_store(lock: &DirLock) -> BasinStore<'_> {
-        TaskStore::new(lock, BASIN_FILES).keeping()
+        TaskStore::new(lock, Lines::of(BASIN_FILES)).keeping()
     }
 }
 

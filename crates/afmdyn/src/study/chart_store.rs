@@ -3,7 +3,7 @@
 //! (one checksummed line per finished tile, its cells under `"cells"`), as
 //! `super::task_store` describes.
 
-use super::task_store::{Encoding, TaskFiles, TaskStore};
+use super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
 use crate::io::dir_lock::DirLock;
 
@@ -17,9 +17,9 @@ pub(crate) const CHART_FILES: TaskFiles = TaskFiles {
 };
 
 /// A chart's store: its tiles' cells by task.
-pub(crate) type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
+pub(crate) type ChartStore<'a> = TaskStore<'a, Lines<Vec<ChartCell>>>;
 
 /// The chart store of the directory `lock` holds.
 pub(crate) fn chart_store(lock: &DirLock) -> ChartStore<'_> {
-    TaskStore::new(lock, CHART_FILES)
+    TaskStore::new(lock, Lines::of(CHART_FILES))
 }

@@ -148,7 +148,7 @@ impl Analysis for GlobalContinuationRequest {
 /// `"step"`), as [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
 pub(crate) mod store {
-    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
+    use super::super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
     use crate::analysis::global_continuation::ContinuationStep;
     use crate::io::dir_lock::DirLock;
 
@@ -162,11 +162,11 @@ pub(crate) mod store {
     };
 
     /// A global continuation's store: its steps by value.
-    pub(crate) type ContinuationStore<'a> = TaskStore<'a, ContinuationStep>;
+    pub(crate) type ContinuationStore<'a> = TaskStore<'a, Lines<ContinuationStep>>;
 
     /// The continuation store of the directory `lock` holds.
     pub(crate) fn continuation_store(lock: &DirLock) -> ContinuationStore<'_> {
-        TaskStore::new(lock, CONTINUATION_FILES).keeping()
+        TaskStore::new(lock, Lines::of(CONTINUATION_FILES)).keeping()
     }
 }
 

@@ -1,12 +1,16 @@
-//! [`MemoryStore`]: a study's finished tasks kept in memory (a run that writes no files).
+//! [`MemoryStore`]: a study's finished tasks kept in memory (a run that writes no files; a
+//! page's bifurcation sweep run chunk by chunk, each chunk a resume of the one before).
 
-use super::{Opened, Store, Study};
-use crate::request::checkpoint::CheckpointError;
+use super::{Opened, Resumes, Store, Study};
+use crate::request::checkpoint::{same_request, CheckpointError, Ledger};
 
-/// The finished tasks of one run, in the order they finished (a memory store never resumes:
-/// every run begins anew). The records are put in the study's one order by their consumer.
+/// The finished tasks of a study, in the order they finished until the study finishes (then in
+/// its one order, [`Study::order`]), and the ledger of the run that made them: a resume of the
+/// same request goes on after them, of another is refused, as a file store's.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct MemoryStore<R> {
+pub struct MemoryStore<R> {
+    /// The ledger (`None`: none recorded).
+    pub ledger: Option<Ledger>,
     /// The finished tasks.
     pub records: Vec<R>,
 }
@@ -14,14 +18,45 @@ pub(crate) struct MemoryStore<R> {
 impl<R> Default for MemoryStore<R> {
     fn default() -> Self {
         MemoryStore {
+            ledger: None,
             records: Vec::new(),
         }
     }
 }
 
-impl<S: Study + ?Sized> Store<S> for MemoryStore<S::Record> {
-    fn open(&mut self, _study: &S, _resume: bool) -> Result<Opened<S::Done>, CheckpointError> {
+impl<S> Store<S> for MemoryStore<S::Record>
+where
+    S: Study + ?Sized,
+    S::Done: Resumes<S::Record>,
+{
+    fn open(&mut self, study: &S, resume: bool) -> Result<Opened<S::Done>, CheckpointError> {
+        if resume {
+            match &self.ledger {
+                None if !self.records.is_empty() => {
+                    return Err(CheckpointError::Unrecorded {
+                        store: "the store".into(),
+                        ledger: "its ledger".into(),
+                    })
+                }
+                None => {}
+                Some(ledger) => {
+                    same_request(&ledger.fingerprint, study.fingerprint(), "")?;
+                    if ledger.finished {
+                        return Ok(Opened::Finished);
+                    }
+                    let mut gathered = Default::default();
+                    for r in &self.records {
+                        S::Done::gather(&mut gathered, r);
+                    }
+                    return Ok(Opened::Run(S::Done::done(gathered)));
+                }
+            }
+        }
         self.records.clear();
+        self.ledger = Some(Ledger {
+            fingerprint: study.fingerprint().clone(),
+            finished: false,
+        });
         Ok(Opened::Run(S::Done::default()))
     }
 
@@ -30,7 +65,12 @@ impl<S: Study + ?Sized> Store<S> for MemoryStore<S::Record> {
         Ok(())
     }
 
-    fn finish(&mut self, _study: &S) -> Result<(), CheckpointError> {
+    fn finish(&mut self, study: &S) -> Result<(), CheckpointError> {
+        study.order(&mut self.records);
+        self.ledger = Some(Ledger {
+            fingerprint: study.fingerprint().clone(),
+            finished: true,
+        });
         Ok(())
     }
 }

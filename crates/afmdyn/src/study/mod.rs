@@ -7,11 +7,13 @@
 //!   sweep's coarse pass before its chain segments, a chart's tiles) stays the study's own.
 //! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
 //!   appends a finished task, and finishes atomically (the files in the one order); the file
-//!   stores lock their directory for one run at a time
-//!   (`crate::request::checkpoint_file::FileCheckpoint` for sweeps; `task_store::TaskStore`,
-//!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `chart_store`; a PI-scanned image's lines, `scan_store`); `MemoryStore` keeps the tasks
-//!   in memory.
+//!   stores lock their directory for one run at a time. Two stores serve every study: the
+//!   file store `task_store::TaskStore` (feature `files`), its records written by a codec —
+//!   JSON lines for a study of numbered tasks whose records serialize (the chart's
+//!   `chart_store`; a PI-scanned image's lines, `scan_store`), the checkpoint's CSV rows for
+//!   a sweep (`sweep::SweepRows`); and [`MemoryStore`], which keeps the tasks in memory
+//!   with the same ledger (a resume of the same request goes on, of another is refused). What
+//!   a resume skips is gathered from the stored records ([`Resumes`]).
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   `crate::request::limits::check_threads`), runs the study, appends each finished task
@@ -27,8 +29,7 @@
 //!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance curve's
 //!   points, one chain through both sweeps, its store `stepped::curve_store`) and
 //!   `peakforce` (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
-//!   sweep's points, its branches continued across them, stored by the request layer's
-//!   checkpoints). A chain's resume reads its stored records back (its next task starts from
+//!   sweep's points, its branches continued across them, stored in its checkpoint). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
@@ -62,12 +63,13 @@ pub mod sweep;
 pub(crate) mod task_store;
 
 pub(crate) use kinds::{in_order, Chain, Tasks};
-pub(crate) use memory::MemoryStore;
+pub use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::request::checkpoint::CheckpointError;
 use serde_json::Value;
+use std::collections::{BTreeMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use thiserror::Error;
@@ -81,6 +83,56 @@ pub(crate) struct Prefix<R>(pub Vec<R>);
 impl<R> Default for Prefix<R> {
     fn default() -> Self {
         Prefix(Vec::new())
+    }
+}
+
+/// What a resumed study skips, gathered from its stored records (in the order stored; a task
+/// stored twice counts once, its first record): the tasks' numbers (`HashSet<usize>`: the
+/// records stay in the store), the records in the order of the tasks (`Vec<R>`), the first
+/// unbroken ones (`Prefix`), or a sweep's points with their chains' last states.
+pub trait Resumes<Record>: Sized {
+    /// What gathers the records.
+    type Gathered: Default;
+    /// Note one stored record.
+    fn gather(gathered: &mut Self::Gathered, record: &Record);
+    /// What is done, from every record gathered.
+    fn done(gathered: Self::Gathered) -> Self;
+}
+
+impl<R> Resumes<(usize, R)> for HashSet<usize> {
+    type Gathered = HashSet<usize>;
+    fn gather(tasks: &mut HashSet<usize>, record: &(usize, R)) {
+        tasks.insert(record.0);
+    }
+    fn done(tasks: HashSet<usize>) -> Self {
+        tasks
+    }
+}
+
+impl<R: Clone> Resumes<(usize, R)> for Vec<R> {
+    type Gathered = BTreeMap<usize, R>;
+    fn gather(records: &mut BTreeMap<usize, R>, (task, record): &(usize, R)) {
+        records.entry(*task).or_insert_with(|| record.clone());
+    }
+    fn done(records: BTreeMap<usize, R>) -> Self {
+        records.into_values().collect()
+    }
+}
+
+impl<R: Clone> Resumes<(usize, R)> for Prefix<R> {
+    type Gathered = BTreeMap<usize, R>;
+    fn gather(records: &mut BTreeMap<usize, R>, record: &(usize, R)) {
+        <Vec<R> as Resumes<(usize, R)>>::gather(records, record);
+    }
+    fn done(records: BTreeMap<usize, R>) -> Self {
+        Prefix(
+            records
+                .into_iter()
+                .enumerate()
+                .take_while(|(k, (task, _))| k == task)
+                .map(|(_, (_, r))| r)
+                .collect(),
+        )
     }
 }
 
@@ -103,6 +155,10 @@ pub trait Study: Sync {
 
     /// The units of one finished task.
     fn record_units(&self, record: &Self::Record) -> u64;
+
+    /// Put the finished tasks of a store in the one order (a sweep's points by value and
+    /// branch); by default they stay in the order they finished.
+    fn order(&self, _records: &mut [Self::Record]) {}
 
     /// Compute every task not in `done` (on the current rayon pool with the `parallel`
     /// feature), handing each finished task to `sink` from the worker threads; start no
@@ -269,7 +325,10 @@ pub(crate) fn execute_in_memory<S: Study + ?Sized>(
     study: &S,
     threads: Option<usize>,
     observer: &dyn Observer,
-) -> Result<Vec<S::Record>, SimError> {
+) -> Result<Vec<S::Record>, SimError>
+where
+    S::Done: Resumes<S::Record>,
+{
     let mut store = MemoryStore::default();
     match execute(study, &mut store, false, threads, observer) {
         Ok(Outcome::Cancelled) => Err(SimError::Cancelled),

@@ -21,13 +21,14 @@
 
 use super::basins::BasinStudy;
 use super::stored::sweep_outcome;
+use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
-use super::StudyError;
+use super::{Opened, StudyError};
 use crate::analysis::am_loop::ScanLine;
 use crate::analysis::basins::{pass_start, passes, run_pass_row, BasinRow, PassStart};
+use crate::analysis::bifurcation::Resume;
 use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
 use crate::error::SimError;
-use crate::request::checkpoint::{self, Checkpoint};
 use crate::request::image::{ImageRequest, SampleMap};
 #[cfg(feature = "files")]
 use crate::request::image_job::ImageKeywords;
@@ -35,7 +36,7 @@ use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
 use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
 use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
-use crate::request::{BasinsRequest, BifurcationRequest, DirLock, FileCheckpoint, Resolved};
+use crate::request::{BasinsRequest, BifurcationRequest, DirLock, Resolved};
 use crate::Params;
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
@@ -377,12 +378,22 @@ struct SweepStore {
     done: HashSet<(usize, Branch)>,
 }
 
+impl SweepStore {
+    /// The checkpoint in the store's directory.
+    fn checkpoint(&self) -> SweepCheckpoint<'_> {
+        sweep_checkpoint(&self.lock)
+    }
+}
+
 impl PlanStore for SweepStore {
     fn open(&mut self, resume: bool) -> Result<Option<Vec<usize>>, StudyError> {
-        let mut s = FileCheckpoint::new(&self.lock);
-        let Some(left) = checkpoint::open(&mut s, &self.fingerprint, resume)? else {
+        let opened = self
+            .checkpoint()
+            .open(&self.fingerprint, resume, |_| false)?;
+        let Opened::Run(left) = opened else {
             return Ok(None);
         };
+        let left: Resume = left;
         let plan = SweepPlan::new(&self.spec);
         let todo = plan
             .tasks(1)
@@ -403,19 +414,20 @@ impl PlanStore for SweepStore {
     }
     fn append(&mut self, result: &str) -> Result<(), StudyError> {
         let recs = sweep_rows(&[result.to_string()])?;
-        let mut s = FileCheckpoint::new(&self.lock);
+        let mut s = self.checkpoint();
         for point in recs.chunk_by(|a, b| (a.index, a.branch) == (b.index, b.branch)) {
-            if self.done.insert((point[0].index, point[0].branch)) {
-                s.append(point)?;
+            if !self.done.contains(&(point[0].index, point[0].branch)) {
+                s.append(point.to_vec())?;
             }
         }
+        self.done.extend(recs.iter().map(|r| (r.index, r.branch)));
         Ok(())
     }
     fn finish(&mut self) -> Result<(), StudyError> {
-        Ok(FileCheckpoint::new(&self.lock).finish(&self.fingerprint)?)
+        Ok(self.checkpoint().finish(&self.fingerprint)?)
     }
     fn outcome(&mut self) -> Result<Outcome, StudyError> {
-        let recs = FileCheckpoint::new(&self.lock).records()?;
+        let recs = crate::request::checkpoint_file::final_rows(self.lock.path())?;
         if let Some(e) = every_point_failed(&recs) {
             return Err(e.into());
         }

@@ -5,7 +5,7 @@
 //! every float bit for bit), as [`super::task_store`] describes. A resumed scan computes only
 //! the lines not stored, and only for the same request.
 
-use super::task_store::{Encoding, TaskFiles, TaskStore};
+use super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
 use crate::analysis::am_loop::ScanLine;
 use crate::io::dir_lock::DirLock;
 
@@ -19,9 +19,9 @@ pub(crate) const SCAN_FILES: TaskFiles = TaskFiles {
 };
 
 /// A PI scan's store: its lines by number.
-pub(crate) type ScanStore<'a> = TaskStore<'a, ScanLine>;
+pub(crate) type ScanStore<'a> = TaskStore<'a, Lines<ScanLine>>;
 
 /// The scan store of the directory `lock` holds.
 pub(crate) fn scan_store(lock: &DirLock) -> ScanStore<'_> {
-    TaskStore::new(lock, SCAN_FILES)
+    TaskStore::new(lock, Lines::of(SCAN_FILES))
 }

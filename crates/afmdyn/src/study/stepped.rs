@@ -244,7 +244,7 @@ impl Analysis for ResonanceRequest {
 /// [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
 pub(crate) mod store {
-    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
+    use super::super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
     use crate::analysis::stepped::CurvePoint;
     use crate::io::dir_lock::DirLock;
 
@@ -258,11 +258,11 @@ pub(crate) mod store {
     };
 
     /// A stepped curve's store: its points by place.
-    pub(crate) type CurveStore<'a> = TaskStore<'a, CurvePoint>;
+    pub(crate) type CurveStore<'a> = TaskStore<'a, Lines<CurvePoint>>;
 
     /// The curve store of the directory `lock` holds.
     pub(crate) fn curve_store(lock: &DirLock) -> CurveStore<'_> {
-        TaskStore::new(lock, CURVE_FILES).keeping()
+        TaskStore::new(lock, Lines::of(CURVE_FILES)).keeping()
     }
 }
 

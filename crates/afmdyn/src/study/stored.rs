@@ -13,9 +13,9 @@ use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
-use super::sweep::SweepStudy;
-use super::task_store::{StoredTasks, TaskStore};
-use super::{execute, MemoryStore, Observer, Study, StudyError};
+use super::sweep::{sweep_checkpoint, SweepStudy};
+use super::task_store::{Codec, Lines, TaskStore};
+use super::{execute, MemoryStore, Observer, Resumes, Study, StudyError};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::analysis::stepped::SteppedCurve;
@@ -23,14 +23,14 @@ use crate::error::SimError;
 use crate::report::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, SweepTally};
 use crate::request::chart::Chart;
 use crate::request::checkpoint::CheckpointError;
-use crate::request::checkpoint_file::each_row;
+use crate::request::checkpoint_file::{each_row, final_csv, final_rows, write_npy};
 use crate::request::image_job::{ImageJob, ImageOutput};
 use crate::request::image_scan::ScanStudy;
 use crate::request::named::{self, Datasets, Outcome};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
+use crate::request::GlobalContinuationRequest;
 use crate::request::{Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock};
-use crate::request::{FileCheckpoint, GlobalContinuationRequest, MemoryCheckpoint};
 use crate::request::{Resolved, ResonanceRequest};
 use serde::de::{DeserializeOwned, Deserializer};
 use serde::{Deserialize, Serialize};
@@ -73,23 +73,32 @@ impl Observer for Watch<'_> {
     }
 }
 
-impl Storage<'_> {
-    /// Run `study` (on `threads`, counting in `progress`) into the task store `open` makes of
-    /// the directory, or into memory: its records.
+/// Where a study ran: the finished file store of the directory, or its records in memory.
+enum Ran<'a, C: Codec> {
+    /// The directory's store.
+    Stored(TaskStore<'a, C>),
+    /// The records.
+    Memory(Vec<C::Record>),
+}
+
+impl<'a> Storage<'a> {
+    /// Run `study` (on `threads`, counting in `progress`) into the store `open` makes of the
+    /// directory, or into memory.
     ///
     /// # Errors
     /// The store's and the study's.
-    fn records<S, R>(
+    fn run<S, C>(
         &self,
         study: &S,
-        open: fn(&DirLock) -> TaskStore<'_, R>,
+        open: impl FnOnce(&'a DirLock) -> TaskStore<'a, C>,
         threads: Option<usize>,
         progress: &Progress,
-    ) -> Result<Vec<(usize, R)>, StudyError>
+    ) -> Result<Ran<'a, C>, StudyError>
     where
-        S: Study<Record = (usize, R)>,
-        S::Done: StoredTasks<R>,
-        R: Serialize + DeserializeOwned + Clone + Send,
+        S: Study<Record = C::Record>,
+        S::Done: Resumes<C::Record>,
+        C: Codec + Send,
+        C::Record: Send,
     {
         let watch = Watch {
             progress,
@@ -99,54 +108,36 @@ impl Storage<'_> {
             Some(lock) => {
                 let mut store = open(lock);
                 execute(study, &mut store, self.resume, threads, &watch)?;
-                Ok(store.records()?)
+                Ok(Ran::Stored(store))
             }
             None => {
                 let mut store = MemoryStore::default();
                 execute(study, &mut store, false, threads, &watch)?;
-                Ok(store.records)
+                Ok(Ran::Memory(store.records))
             }
         }
     }
-}
 
-/// A sweep run: into the directory's checkpoint (its rows in its `bifurcation.csv`), or into
-/// memory.
-pub(crate) enum Swept<'a> {
-    /// The directory's checkpoint, finished.
-    Stored(FileCheckpoint<'a>),
-    /// The records.
-    Memory(Vec<SweepRecord>),
-}
-
-impl<'a> Storage<'a> {
-    /// Run the sweep `study` (on `threads`, counting in `progress`) into the directory's
-    /// checkpoint, or into memory.
+    /// Run `study` as [`Storage::run`] into the JSON-lines store `open` makes: its records.
     ///
     /// # Errors
     /// The store's and the study's.
-    pub(crate) fn sweep(
+    fn records<S, R>(
         &self,
-        study: &SweepStudy,
+        study: &S,
+        open: fn(&DirLock) -> TaskStore<'_, Lines<R>>,
         threads: Option<usize>,
         progress: &Progress,
-    ) -> Result<Swept<'a>, StudyError> {
-        let watch = Watch {
-            progress,
-            abort_after: self.abort_after,
-        };
-        match self.lock {
-            Some(lock) => {
-                let mut s = FileCheckpoint::new(lock);
-                execute(study, &mut s, self.resume, threads, &watch)?;
-                Ok(Swept::Stored(s))
-            }
-            None => {
-                let mut s = MemoryCheckpoint::default();
-                execute(study, &mut s, false, threads, &watch)?;
-                Ok(Swept::Memory(s.into_records()))
-            }
-        }
+    ) -> Result<Vec<(usize, R)>, StudyError>
+    where
+        S: Study<Record = (usize, R)>,
+        S::Done: Resumes<(usize, R)>,
+        R: Serialize + DeserializeOwned + Clone + Send,
+    {
+        Ok(match self.run(study, open, threads, progress)? {
+            Ran::Stored(mut store) => store.records()?,
+            Ran::Memory(records) => records,
+        })
     }
 }
 
@@ -367,17 +358,19 @@ impl Resumable for SweepInto {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<SweepFiles, StudyError> {
-        let Swept::Stored(store) = storage.sweep(study, self.0.threads, progress)? else {
+        let sweep = storage.run(study, sweep_checkpoint, self.0.threads, progress)?;
+        let Ran::Stored(store) = sweep else {
             return Err(SimError::File(NO_DIRECTORY.into()).into());
         };
         // derived from the finished rows, streamed
-        let csv = store.final_csv();
+        let dir = store.dir();
+        let csv = final_csv(dir);
         let mut tally = SweepTally::default();
         each_row(&csv, &mut |r| -> Result<(), CheckpointError> {
             tally.add_row(SweepRow::from_csv(r));
             Ok(())
         })?;
-        let npy = store.write_npy(self.0.param).map_err(SimError::from)?;
+        let npy = write_npy(dir, self.0.param).map_err(SimError::from)?;
         Ok(SweepFiles {
             spec: study.spec.clone(),
             tally,
@@ -518,9 +511,9 @@ impl Prepared for Sweep {
             resume,
             abort_after: None,
         };
-        let records = match storage.sweep(&study, self.request.threads, progress)? {
-            Swept::Stored(store) => store.records()?,
-            Swept::Memory(records) => records,
+        let records = match storage.run(&study, sweep_checkpoint, self.request.threads, progress)? {
+            Ran::Stored(store) => final_rows(store.dir())?,
+            Ran::Memory(points) => points.into_iter().flatten().collect(),
         };
         if let Some(e) = every_point_failed(&records) {
             return Err(e.into());

@@ -1,15 +1,14 @@
 //! A bifurcation sweep as a [`Study`] ([`SweepStudy`]): a task is one point (a value reached
 //! one way), its record the point's rows ([`SweepRecord`]), what a resume skips the stored
-//! points with the chains' last states ([`Resume`]); the request layer's checkpoints
-//! ([`Checkpoint`]: in memory, or a directory with the `files` feature) are its stores.
+//! points with the chains' last states ([`Resume`]). Its stores are every study's: in memory
+//! ([`super::MemoryStore`]), or with the `files` feature its checkpoint's CSV in a directory
+//! (a `TaskStore` written by `SweepRows`).
 
-use super::{Opened, Store, Study};
-use crate::analysis::bifurcation::{run_sweep_cancellable, Resume, SweepPoint, SweepSpec};
+use super::{Resumes, Study};
+use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::checkpoint::{
-    open, point_count, Checkpoint, CheckpointError, MemoryCheckpoint,
-};
+use crate::request::checkpoint::{end_state, point_count};
 use crate::request::costs::{state_bytes, steady_periods, MODEL_BYTES};
 use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
@@ -55,6 +54,10 @@ impl Study for SweepStudy {
 
     fn record_units(&self, _: &Vec<SweepRecord>) -> u64 {
         1
+    }
+
+    fn order(&self, points: &mut [Vec<SweepRecord>]) {
+        points.sort_by_key(|p| p.first().map(|r| (r.index, r.branch)));
     }
 
     fn run(
@@ -132,36 +135,82 @@ impl Analysis for BifurcationRequest {
     }
 }
 
-/// [`Store`] of a sweep for a [`Checkpoint`]: [`open`], [`Checkpoint::append`],
-/// [`Checkpoint::finish`].
-macro_rules! sweep_store {
-    ($t:ty) => {
-        impl Store<SweepStudy> for $t {
-            fn open(
-                &mut self,
-                study: &SweepStudy,
-                resume: bool,
-            ) -> Result<Opened<Resume>, CheckpointError> {
-                Ok(match open(self, &study.fingerprint, resume)? {
-                    Some(r) => Opened::Run(r),
-                    None => Opened::Finished,
-                })
-            }
-
-            fn append(&mut self, record: Vec<SweepRecord>) -> Result<(), CheckpointError> {
-                Checkpoint::append(self, &record)
-            }
-
-            fn finish(&mut self, study: &SweepStudy) -> Result<(), CheckpointError> {
-                Checkpoint::finish(self, &study.fingerprint)
+/// A resumed sweep skips its stored points and goes on along each continued branch from the
+/// state of its last stored point that did not fail.
+impl Resumes<Vec<SweepRecord>> for Resume {
+    type Gathered = Resume;
+    fn gather(resume: &mut Resume, point: &Vec<SweepRecord>) {
+        let Some(first) = point.first() else { return };
+        let key = (first.index, first.branch);
+        resume.done.insert(key);
+        if let Some(z) = end_state(point) {
+            if matches!(first.branch, Branch::Forward | Branch::Backward) {
+                resume.chain.insert(key, z);
             }
         }
-    };
+    }
+    fn done(resume: Resume) -> Resume {
+        resume
+    }
 }
 
-sweep_store!(MemoryCheckpoint);
+/// The codec of a sweep's checkpoint (the directory's `.bifurcation.run.json` and
+/// `.bifurcation.partial.csv`, its rows put in the one order in `bifurcation.csv` when the
+/// sweep finishes: `crate::request::checkpoint_file`), a point's rows stored together.
 #[cfg(feature = "files")]
-sweep_store!(crate::request::checkpoint_file::FileCheckpoint<'_>);
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SweepRows;
+
+#[cfg(feature = "files")]
+impl super::task_store::Codec for SweepRows {
+    type Record = Vec<SweepRecord>;
+
+    fn layout(&self) -> super::task_store::Layout {
+        use crate::request::checkpoint_file::{FINAL_CSV, LEDGER, PARTIAL_CSV};
+        super::task_store::Layout {
+            ledger: LEDGER,
+            records: PARTIAL_CSV,
+            prefix: "",
+            format: None,
+            finished: Some(FINAL_CSV),
+            ledger_by_path: true,
+        }
+    }
+
+    fn header(&self) -> Option<String> {
+        Some(crate::request::checkpoint_file::partial_header())
+    }
+
+    fn encode(&self, point: &Vec<SweepRecord>) -> Result<String, String> {
+        let seal = |r: &SweepRecord| crate::request::checkpoint_file::sealed(&r.csv_line()) + "\n";
+        Ok(point.iter().map(seal).collect())
+    }
+
+    fn read(
+        &self,
+        path: &std::path::Path,
+        each: &mut dyn FnMut(Vec<SweepRecord>),
+    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
+        crate::request::checkpoint_file::read_points(path, each)
+    }
+
+    fn finish(
+        &self,
+        dir: &std::path::Path,
+    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
+        crate::request::checkpoint_file::sort_into_final(dir)
+    }
+}
+
+/// A sweep's checkpoint in the directory a lock holds.
+#[cfg(feature = "files")]
+pub(crate) type SweepCheckpoint<'a> = super::task_store::TaskStore<'a, SweepRows>;
+
+/// The sweep's checkpoint in the directory `lock` holds.
+#[cfg(feature = "files")]
+pub(crate) fn sweep_checkpoint(lock: &crate::io::dir_lock::DirLock) -> SweepCheckpoint<'_> {
+    super::task_store::TaskStore::new(lock, SweepRows)
+}
 
 #[cfg(test)]
 #[path = "sweep_tests.rs"]

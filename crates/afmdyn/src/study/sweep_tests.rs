@@ -8,10 +8,9 @@ use crate::analysis::progress::Progress;
 use crate::params::Params;
 use crate::request::checkpoint::*;
 use crate::request::sweep::SweepRecord;
-use crate::request::sweep::{fingerprint, order_key, PointStatus, HEADER};
+use crate::request::sweep::{order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
-use crate::study::execute;
-use crate::study::StudyError;
+use crate::study::{execute, MemoryStore, Opened, Store, StudyError};
 use std::collections::HashSet;
 use std::sync::Mutex;
 
@@ -73,10 +72,18 @@ fn resume_into<C: Store<SweepStudy>>(
     Ok(noting.computed)
 }
 
+/// A sweep's store in memory.
+type SweepMemory = MemoryStore<Vec<SweepRecord>>;
+
+/// The records of a store, point after point.
+fn flat(store: SweepMemory) -> Vec<SweepRecord> {
+    store.records.into_iter().flatten().collect()
+}
+
 /// An uninterrupted sweep: the store before `finish` (points in the order they finished) and
 /// the finished records.
-fn uninterrupted(r: &BifurcationRequest) -> (MemoryCheckpoint, Vec<SweepRecord>) {
-    let mut store = MemoryCheckpoint::default();
+fn uninterrupted(r: &BifurcationRequest) -> (SweepMemory, Vec<SweepRecord>) {
+    let mut store = SweepMemory::default();
     let s = SweepStudy::new(r, spec(r));
     let Opened::Run(resume) = Store::open(&mut store, &s, false).unwrap() else {
         panic!("a new sweep runs")
@@ -89,11 +96,11 @@ fn uninterrupted(r: &BifurcationRequest) -> (MemoryCheckpoint, Vec<SweepRecord>)
     )
     .unwrap();
     for rec in sink.into_inner().unwrap() {
-        Store::append(&mut store, rec).unwrap();
+        Store::<SweepStudy>::append(&mut store, rec).unwrap();
     }
     let unfinished = store.clone();
     Store::finish(&mut store, &s).unwrap();
-    (unfinished, store.into_records())
+    (unfinished, flat(store))
 }
 
 #[test]
@@ -152,15 +159,15 @@ fn a_failed_point_is_one_row_with_its_message_and_codes() {
 fn a_resume_computes_exactly_the_points_not_stored() {
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);
-    let total = unfinished.points.len();
+    let total = unfinished.records.len();
     for k in [0, 1, total / 2, total - 1, total] {
         // interrupted after k points, in the order they finished
-        let mut store = MemoryCheckpoint {
-            points: unfinished.points[..k].to_vec(),
+        let mut store = SweepMemory {
+            records: unfinished.records[..k].to_vec(),
             ..unfinished.clone()
         };
         let stored: HashSet<_> = store
-            .points
+            .records
             .iter()
             .map(|p| (p[0].index, p[0].branch))
             .collect();
@@ -172,7 +179,7 @@ fn a_resume_computes_exactly_the_points_not_stored() {
         );
         assert!(computed.iter().all(|c| !stored.contains(c)), "after {k}");
         assert_eq!(
-            lines(&store.into_records()),
+            lines(&flat(store)),
             lines(&reference),
             "after {k}: the rows of the uninterrupted sweep"
         );
@@ -182,7 +189,7 @@ fn a_resume_computes_exactly_the_points_not_stored() {
 #[test]
 fn a_finished_store_computes_nothing() {
     let r = request();
-    let mut store = MemoryCheckpoint::default();
+    let mut store = SweepMemory::default();
     assert_eq!(
         resume_into(&mut store, &r).unwrap().len(),
         point_count(&spec(&r))
@@ -219,7 +226,8 @@ fn another_request_is_refused_naming_the_first_field_that_differs() {
         alpha4: 30.0,
         ..Params::default()
     };
-    let err = open(&mut store, &fingerprint(&r, &r.spec(&p).unwrap()), true).unwrap_err();
+    let study = SweepStudy::new(&r, r.spec(&p).unwrap());
+    let err = Store::open(&mut store, &study, true).unwrap_err();
     assert_eq!(
         err.to_string(),
         "alpha4 = 20.0 in the interrupted run, 30.0 now"
@@ -227,7 +235,8 @@ fn another_request_is_refused_naming_the_first_field_that_differs() {
     // listed values instead of from/to/steps: named as such
     let mut listed = r.clone();
     listed.values = Some(vec![2.4, 2.5]);
-    let err = open(&mut store, &fingerprint(&listed, &spec(&listed)), true).unwrap_err();
+    let study = SweepStudy::new(&listed, spec(&listed));
+    let err = Store::open(&mut store, &study, true).unwrap_err();
     assert_eq!(
         err.to_string(),
         "from = 2.4 in the interrupted run, absent now"
@@ -237,7 +246,7 @@ fn another_request_is_refused_naming_the_first_field_that_differs() {
 #[test]
 fn records_without_a_ledger_are_not_resumed() {
     let (unfinished, _) = uninterrupted(&request());
-    let mut store = MemoryCheckpoint {
+    let mut store = SweepMemory {
         ledger: None,
         ..unfinished
     };
@@ -251,22 +260,27 @@ fn records_without_a_ledger_are_not_resumed() {
 #[test]
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     use crate::io::dir_lock::DirLock;
-    use crate::request::checkpoint_file::{FileCheckpoint, LEDGER, PARTIAL_CSV};
+    use crate::request::checkpoint_file::{final_rows, LEDGER, PARTIAL_CSV};
+    use crate::request::sweep::fingerprint;
+    use crate::study::task_store::TaskStore;
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);
     let dir = std::env::temp_dir().join(format!("afmdyn-checkpoint-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let lock = DirLock::acquire(&dir).unwrap();
-    let mut store = FileCheckpoint::new(&lock);
+    let mut store = TaskStore::new(&lock, SweepRows);
     let s = spec(&r);
     let fp = fingerprint(&r, &s);
     assert!(
-        open(&mut store, &fp, true).unwrap().is_some(),
+        matches!(
+            store.open::<Resume>(&fp, true, |_| false).unwrap(),
+            Opened::Run(_)
+        ),
         "empty: begins"
     );
     let k = 5;
-    for p in &unfinished.points[..k] {
-        Checkpoint::append(&mut store, p).unwrap();
+    for p in &unfinished.records[..k] {
+        store.append(p.clone()).unwrap();
     }
     drop(store);
     drop(lock);
@@ -276,10 +290,10 @@ fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     text.push_str("omega,2.5,1,start-0,peri");
     std::fs::write(&partial, text).unwrap();
     let lock = DirLock::acquire(&dir).unwrap();
-    let mut store = FileCheckpoint::new(&lock);
+    let mut store = TaskStore::new(&lock, SweepRows);
     let computed = resume_into(&mut store, &r).unwrap();
-    assert_eq!(computed.len(), unfinished.points.len() - k);
-    assert_eq!(lines(&store.records().unwrap()), lines(&reference));
+    assert_eq!(computed.len(), unfinished.records.len() - k);
+    assert_eq!(lines(&final_rows(&dir).unwrap()), lines(&reference));
     assert!(!partial.exists());
     let ledger = std::fs::read_to_string(dir.join(LEDGER)).unwrap();
     assert!(ledger.contains("\"finished\": true"), "{ledger}");
