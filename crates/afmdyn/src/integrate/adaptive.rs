@@ -589,18 +589,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
 }
 
 impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
+    current_fields!();
     fn name(&self) -> &'static str {
         "adaptive"
     }

@@ -32,6 +32,26 @@
 //! at `tau_max`, or at an event (switching, impact, sticking, release), which it reports as a
 //! [`SwitchEvent`].
 
+/// The accessors [`Integrator::system`], [`Integrator::tau`], [`Integrator::state`] and
+/// [`Integrator::region`] of an integrator that keeps them in its fields `model`, `tau`, `z` and
+/// `region`.
+macro_rules! current_fields {
+    () => {
+        fn system(&self) -> &dyn TipSampleSystem {
+            &self.model
+        }
+        fn tau(&self) -> f64 {
+            self.tau
+        }
+        fn state(&self) -> &DVector<f64> {
+            &self.z
+        }
+        fn region(&self) -> Region {
+            self.region
+        }
+    };
+}
+
 pub mod adaptive;
 pub(crate) mod dense;
 mod dop853;

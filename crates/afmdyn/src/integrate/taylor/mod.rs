@@ -293,18 +293,7 @@ fn keep_jacobian(
 }
 
 impl Integrator for Taylor {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
+    current_fields!();
     fn name(&self) -> &'static str {
         "taylor"
     }
