@@ -274,11 +274,6 @@ impl AmCurveModel {
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
-
-    /// The parameters at `p` (SI, the model's order), z_offset, and the chain rule.
-    fn scaled(&self, p: &[f64]) -> (Params, f64, Chain) {
-        scaled(&self.probe, &self.params, p)
-    }
 }
 
 /// The gaps α5 of the rows at the piezo positions `z` (m), shifted by `z_offset` (m), under the
@@ -480,12 +475,62 @@ impl CheckedModel for AmCurveModel {
         &self,
         p: &[f64],
         values: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
+    ) -> Result<Vec<String>, SimError> {
+        let (amp, ph) = self.channels;
+        let rows = SteppedRows {
+            probe: &self.probe,
+            z: &self.z,
+            params: &self.params,
+            spec: &self.spec,
+            tolerance: self.tolerance,
+            channels: [amp, ph, false, false],
+            component: None,
+        };
+        rows.evaluate(p, values, jacobian, cancel)
+    }
+}
+
+/// What the AM and the bimodal models evaluate alike: the rows `z` (m) under `probe` as the
+/// stepped approach of `spec`, with parameters `params`, the sensitivities to `tolerance`.
+pub(crate) struct SteppedRows<'a> {
+    /// The probe.
+    pub probe: &'a AmProbe,
+    /// The piezo positions z (m) of the rows, in the order the instrument stepped.
+    pub z: &'a [f64],
+    /// The model's parameters, in the fit's order.
+    pub params: &'a [AmParam],
+    /// The stepped sweep's settings (its values are overwritten by the rows').
+    pub spec: &'a SteppedSpec,
+    /// The adaptive integrator's tolerance of the sensitivities.
+    pub tolerance: f64,
+    /// Which of (A₁, φ₁, A₂, φ₂) are the values, in that order.
+    pub channels: [bool; 4],
+    /// The further drive component whose harmonic is A₂, φ₂ ([`orbit_sensitivity`]'s;
+    /// `None` where they are not asked for).
+    pub component: Option<usize>,
+}
+
+impl SteppedRows<'_> {
+    /// The values of the fitted channels at `p` (A g₀ in m, φ in deg), each channel's rows in
+    /// turn, and with `jacobian` their sensitivities (rows off a stable period-1 orbit: the
+    /// stepped sweep's observables, a zero Jacobian row); the warnings. Stops at the next row
+    /// once `cancel` is set.
+    ///
+    /// # Errors
+    /// The stepped sweep's, the model's or the sensitivities' failure;
+    /// [`SimError::Cancelled`].
+    pub(crate) fn evaluate(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
         mut jacobian: Option<&mut [f64]>,
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
-        let (q, z_offset, chain) = self.scaled(p);
+        let (q, z_offset, chain) = scaled(self.probe, self.params, p);
         let g0 = self.probe.length_m;
-        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
+        let alpha5 = gaps(self.probe, &q, self.z, z_offset);
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();
@@ -493,22 +538,39 @@ impl CheckedModel for AmCurveModel {
         let orbit_params = chain.orbit_params();
         let m = self.z.len();
         let n = self.params.len();
-        let (amp, ph) = self.channels;
-        let phase_row = if amp { m } else { 0 };
+        // each fitted channel's first value
+        let mut offset = [0usize; 4];
+        let mut next = 0;
+        for (c, on) in self.channels.iter().enumerate() {
+            offset[c] = next;
+            if *on {
+                next += m;
+            }
+        }
         let deg = 180.0 / std::f64::consts::PI;
+        let scale = [g0, deg, g0, deg];
         let mut warnings = Vec::new();
         let mut off = 0;
+        if let Some(j) = jacobian.as_deref_mut() {
+            j.fill(0.0);
+        }
         for (i, point) in first.iter().enumerate() {
             if cancel.load(Ordering::Relaxed) {
                 return Err(SimError::Cancelled);
             }
-            let mut a = point.observables.amplitude;
-            let mut phi = point.observables.phase;
-            let mut da = vec![0.0; n];
-            let mut dphi = vec![0.0; n];
+            let o = &point.observables;
+            let second = o.components.get(1);
+            let mut v = [
+                o.amplitude,
+                o.phase,
+                second.map_or(f64::NAN, |c| c.amplitude),
+                second.map_or(f64::NAN, |c| c.phase),
+            ];
+            let mut d = vec![vec![0.0; n]; 4];
+            let on_orbit = point.period == Some(1) && point.stable;
             // the values alone (the residuals) are the sweep's observables; with the Jacobian,
             // those of the sensitivities' Fourier integrals (the same to the integration error)
-            if jacobian.is_some() && point.period == Some(1) && point.stable {
+            if jacobian.is_some() && on_orbit {
                 let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
                 let s = orbit_sensitivity(
                     &model,
@@ -516,36 +578,39 @@ impl CheckedModel for AmCurveModel {
                     &point.state,
                     &orbit_params,
                     None,
-                    None,
+                    self.component,
                 )?;
-                a = s.amplitude;
-                phi = s.phase;
                 for w in &s.warnings {
                     warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
                 }
                 // (gap, α4, H̃, α6, P̃) → (E_s, H, z_offset, R, c, W)
-                let map = |d: &[f64]| -> Vec<f64> {
-                    let si = |a: &AmParam| chain.to_si(&orbit_params, d, *a);
+                let map = |dd: &[f64]| -> Vec<f64> {
+                    let si = |a: &AmParam| chain.to_si(&orbit_params, dd, *a);
                     self.params.iter().map(si).collect()
                 };
-                da = map(&s.d_amplitude);
-                dphi = map(&s.d_phase);
-            } else if point.period != Some(1) || !point.stable {
+                (v[0], v[1]) = (s.amplitude, s.phase);
+                (d[0], d[1]) = (map(&s.d_amplitude), map(&s.d_phase));
+                if self.component.is_some() {
+                    let two = s.component.as_ref().ok_or(SimError::NoConvergence {
+                        what: "the second component's harmonic",
+                        iterations: 0,
+                        residual: f64::NAN,
+                    })?;
+                    (v[2], v[3]) = (two.amplitude, two.phase);
+                    (d[2], d[3]) = (map(&two.d_amplitude), map(&two.d_phase));
+                }
+            } else if !on_orbit {
                 off += 1;
             }
-            if amp {
-                values[i] = a * g0;
-            }
-            if ph {
-                values[phase_row + i] = phi * deg;
-            }
-            if let Some(j) = jacobian.as_deref_mut() {
-                for k in 0..n {
-                    if amp {
-                        j[i * n + k] = da[k] * g0;
-                    }
-                    if ph {
-                        j[(phase_row + i) * n + k] = dphi[k] * deg;
+            for c in 0..4 {
+                if !self.channels[c] {
+                    continue;
+                }
+                let row = offset[c] + i;
+                values[row] = v[c] * scale[c];
+                if let Some(j) = jacobian.as_deref_mut() {
+                    for k in 0..n {
+                        j[row * n + k] = d[c][k] * scale[c];
                     }
                 }
             }

@@ -13,15 +13,11 @@
 //! observables without a Jacobian row, and the warnings say so, as at folds and grazing.
 
 use super::am_curve::CheckedModel;
-use super::am_curve::{
-    first_sweep_cancellable, gaps, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE,
-};
-use super::sensitivity::orbit_sensitivity;
+use super::am_curve::{AmParam, AmProbe, SteppedRows, SENSITIVITY_TOLERANCE};
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
-use crate::model::CantileverModel;
 use crate::params::SweepParam;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
 
 /// The model of a measured bimodal curve (module docs).
@@ -77,7 +73,7 @@ impl CheckedModel for BimodalCurveModel {
         &self,
         p: &[f64],
         values: &mut [f64],
-        mut jacobian: Option<&mut [f64]>,
+        jacobian: Option<&mut [f64]>,
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
         if !self.probe.params.is_multifrequency() {
@@ -97,98 +93,15 @@ impl CheckedModel for BimodalCurveModel {
                 "Q is fitted under a drive of at most two components",
             ));
         }
-        let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
-        let g0 = self.probe.length_m;
-        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
-        let mut spec = self.spec.clone();
-        spec.base = q;
-        spec.values = alpha5.clone();
-        let first = first_sweep_cancellable(&spec, cancel)?;
-        let orbit_params = chain.orbit_params();
-        let m = self.z.len();
-        let n = self.params.len();
-        // each fitted channel's first value
-        let mut offset = [0usize; 4];
-        let mut next = 0;
-        for (c, on) in self.channels.iter().enumerate() {
-            offset[c] = next;
-            if *on {
-                next += m;
-            }
-        }
-        let deg = 180.0 / std::f64::consts::PI;
-        let scale = [g0, deg, g0, deg];
-        let mut warnings = Vec::new();
-        let mut off = 0;
-        if let Some(j) = jacobian.as_deref_mut() {
-            j.fill(0.0);
-        }
-        for (i, point) in first.iter().enumerate() {
-            let o = &point.observables;
-            let second = o.components.get(1);
-            let mut v = [
-                o.amplitude,
-                o.phase,
-                second.map_or(f64::NAN, |c| c.amplitude),
-                second.map_or(f64::NAN, |c| c.phase),
-            ];
-            let mut d = vec![vec![0.0; n]; 4];
-            let on_orbit = point.period == Some(1) && point.stable;
-            if jacobian.is_some() && on_orbit {
-                if cancel.load(Ordering::Relaxed) {
-                    return Err(SimError::Cancelled);
-                }
-                let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
-                let s = orbit_sensitivity(
-                    &model,
-                    self.tolerance,
-                    &point.state,
-                    &orbit_params,
-                    None,
-                    Some(1),
-                )?;
-                for w in &s.warnings {
-                    warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
-                }
-                let two = s.component.as_ref().ok_or(SimError::NoConvergence {
-                    what: "the second component's harmonic",
-                    iterations: 0,
-                    residual: f64::NAN,
-                })?;
-                v = [s.amplitude, s.phase, two.amplitude, two.phase];
-                // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
-                let map = |dd: &[f64]| -> Vec<f64> {
-                    let si = |a: &AmParam| chain.to_si(&orbit_params, dd, *a);
-                    self.params.iter().map(si).collect()
-                };
-                d = vec![
-                    map(&s.d_amplitude),
-                    map(&s.d_phase),
-                    map(&two.d_amplitude),
-                    map(&two.d_phase),
-                ];
-            } else if !on_orbit {
-                off += 1;
-            }
-            for c in 0..4 {
-                if !self.channels[c] {
-                    continue;
-                }
-                let row = offset[c] + i;
-                values[row] = v[c] * scale[c];
-                if let Some(j) = jacobian.as_deref_mut() {
-                    for k in 0..n {
-                        j[row * n + k] = d[c][k] * scale[c];
-                    }
-                }
-            }
-        }
-        if off > 0 {
-            warnings.push(format!(
-                "{off} row(s) not on a stable period-1 orbit: their model values are the stepped \
-                 sweep's, without sensitivities"
-            ));
-        }
-        Ok(warnings)
+        let rows = SteppedRows {
+            probe: &self.probe,
+            z: &self.z,
+            params: &self.params,
+            spec: &self.spec,
+            tolerance: self.tolerance,
+            channels: self.channels,
+            component: Some(1),
+        };
+        rows.evaluate(p, values, jacobian, cancel)
     }
 }
