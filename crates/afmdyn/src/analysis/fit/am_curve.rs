@@ -232,15 +232,43 @@ impl AmProbe {
     }
 }
 
-/// The model of a measured AM curve (module docs).
+/// The channels of a [`SteppedCurveModel`]: the AM curve's (amplitude, phase), the bimodal
+/// curve's (A₁, φ₁, A₂, φ₂) ([`super::bimodal_curve`]).
+pub trait Channels: Copy + std::fmt::Debug {
+    /// The further drive component whose harmonic is A₂, φ₂ (`None`: the first harmonic alone).
+    const COMPONENT: Option<usize>;
+    /// Which of (A₁, φ₁, A₂, φ₂) are the values, in that order.
+    fn fitted(&self) -> [bool; 4];
+    /// Refuse a probe or parameters the channels cannot be evaluated under (none for the AM
+    /// curve's).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming what is refused.
+    fn check(probe: &AmProbe, params: &[AmParam]) -> Result<(), SimError> {
+        let _ = (probe, params);
+        Ok(())
+    }
+}
+
+/// The amplitude and the phase: the values are the amplitudes, then the phases.
+impl Channels for (bool, bool) {
+    const COMPONENT: Option<usize> = None;
+    fn fitted(&self) -> [bool; 4] {
+        [self.0, self.1, false, false]
+    }
+}
+
+/// The model of a measured curve as the stepped approach of its rows (module docs): the AM
+/// curve's ([`AmCurveModel`]) or the bimodal channels'
+/// ([`super::bimodal_curve::BimodalCurveModel`]).
 #[derive(Debug)]
-pub struct AmCurveModel {
-    /// The probe.
+pub struct SteppedCurveModel<C> {
+    /// The probe (for the bimodal channels, its drive with a second component).
     pub probe: AmProbe,
     /// The piezo positions z (m) of the rows, in the order the instrument stepped.
     pub z: Vec<f64>,
-    /// Whether the amplitude and the phase are fitted (values: the amplitudes, then the phases).
-    pub channels: (bool, bool),
+    /// Which channels are fitted ([`Channels::fitted`]), in that order of the values.
+    pub channels: C,
     /// The model's parameters, in the fit's order.
     pub params: Vec<AmParam>,
     /// The stepped sweep's settings (its values are overwritten by the rows').
@@ -252,14 +280,17 @@ pub struct AmCurveModel {
     warnings: Mutex<Vec<String>>,
 }
 
-impl AmCurveModel {
+/// The model of a measured AM curve (module docs).
+pub type AmCurveModel = SteppedCurveModel<(bool, bool)>;
+
+impl<C: Channels> SteppedCurveModel<C> {
     /// A model of the rows `z` (m) under `probe`, with parameters `params` and the channels
-    /// (amplitude, phase).
-    pub fn new(probe: AmProbe, z: Vec<f64>, channels: (bool, bool), params: Vec<AmParam>) -> Self {
+    /// (amplitude, phase; or A₁, φ₁, A₂, φ₂).
+    pub fn new(probe: AmProbe, z: Vec<f64>, channels: C, params: Vec<AmParam>) -> Self {
         let mut spec = SteppedSpec::new(probe.params, SweepParam::Alpha5, Vec::new());
         spec.branches = false;
         let tolerance = SENSITIVITY_TOLERANCE;
-        AmCurveModel {
+        SteppedCurveModel {
             probe,
             z,
             channels,
@@ -464,9 +495,12 @@ fn component_following(pr: &AmProbe, q: &mut Params) -> Option<f64> {
     derivative
 }
 
-impl CheckedModel for AmCurveModel {
+/// The values of the fitted channels at `p` (A g₀ in m, φ in deg), each channel's rows in turn,
+/// and with the Jacobian their sensitivities (rows off a stable period-1 orbit: the stepped
+/// sweep's observables, a zero Jacobian row); stops at the next row once `cancel` is set.
+impl<C: Channels> CheckedModel for SteppedCurveModel<C> {
     fn rows(&self) -> usize {
-        self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
+        self.z.len() * self.channels.fitted().iter().filter(|c| **c).count()
     }
     fn kept(&self) -> &Mutex<Vec<String>> {
         &self.warnings
@@ -475,62 +509,14 @@ impl CheckedModel for AmCurveModel {
         &self,
         p: &[f64],
         values: &mut [f64],
-        jacobian: Option<&mut [f64]>,
-        cancel: &AtomicBool,
-    ) -> Result<Vec<String>, SimError> {
-        let (amp, ph) = self.channels;
-        let rows = SteppedRows {
-            probe: &self.probe,
-            z: &self.z,
-            params: &self.params,
-            spec: &self.spec,
-            tolerance: self.tolerance,
-            channels: [amp, ph, false, false],
-            component: None,
-        };
-        rows.evaluate(p, values, jacobian, cancel)
-    }
-}
-
-/// What the AM and the bimodal models evaluate alike: the rows `z` (m) under `probe` as the
-/// stepped approach of `spec`, with parameters `params`, the sensitivities to `tolerance`.
-pub(crate) struct SteppedRows<'a> {
-    /// The probe.
-    pub probe: &'a AmProbe,
-    /// The piezo positions z (m) of the rows, in the order the instrument stepped.
-    pub z: &'a [f64],
-    /// The model's parameters, in the fit's order.
-    pub params: &'a [AmParam],
-    /// The stepped sweep's settings (its values are overwritten by the rows').
-    pub spec: &'a SteppedSpec,
-    /// The adaptive integrator's tolerance of the sensitivities.
-    pub tolerance: f64,
-    /// Which of (A₁, φ₁, A₂, φ₂) are the values, in that order.
-    pub channels: [bool; 4],
-    /// The further drive component whose harmonic is A₂, φ₂ ([`orbit_sensitivity`]'s;
-    /// `None` where they are not asked for).
-    pub component: Option<usize>,
-}
-
-impl SteppedRows<'_> {
-    /// The values of the fitted channels at `p` (A g₀ in m, φ in deg), each channel's rows in
-    /// turn, and with `jacobian` their sensitivities (rows off a stable period-1 orbit: the
-    /// stepped sweep's observables, a zero Jacobian row); the warnings. Stops at the next row
-    /// once `cancel` is set.
-    ///
-    /// # Errors
-    /// The stepped sweep's, the model's or the sensitivities' failure;
-    /// [`SimError::Cancelled`].
-    pub(crate) fn evaluate(
-        &self,
-        p: &[f64],
-        values: &mut [f64],
         mut jacobian: Option<&mut [f64]>,
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
-        let (q, z_offset, chain) = scaled(self.probe, self.params, p);
+        C::check(&self.probe, &self.params)?;
+        let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let g0 = self.probe.length_m;
-        let alpha5 = gaps(self.probe, &q, self.z, z_offset);
+        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
+        let channels = self.channels.fitted();
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();
@@ -541,7 +527,7 @@ impl SteppedRows<'_> {
         // each fitted channel's first value
         let mut offset = [0usize; 4];
         let mut next = 0;
-        for (c, on) in self.channels.iter().enumerate() {
+        for (c, on) in channels.iter().enumerate() {
             offset[c] = next;
             if *on {
                 next += m;
@@ -578,7 +564,7 @@ impl SteppedRows<'_> {
                     &point.state,
                     &orbit_params,
                     None,
-                    self.component,
+                    C::COMPONENT,
                 )?;
                 for w in &s.warnings {
                     warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
@@ -590,7 +576,7 @@ impl SteppedRows<'_> {
                 };
                 (v[0], v[1]) = (s.amplitude, s.phase);
                 (d[0], d[1]) = (map(&s.d_amplitude), map(&s.d_phase));
-                if self.component.is_some() {
+                if C::COMPONENT.is_some() {
                     let two = s.component.as_ref().ok_or(SimError::NoConvergence {
                         what: "the second component's harmonic",
                         iterations: 0,
@@ -603,7 +589,7 @@ impl SteppedRows<'_> {
                 off += 1;
             }
             for c in 0..4 {
-                if !self.channels[c] {
+                if !channels[c] {
                     continue;
                 }
                 let row = offset[c] + i;
