@@ -589,35 +589,8 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
 }
 
 impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
-    fn name(&self) -> &'static str {
-        "adaptive"
-    }
-    fn work(&self) -> u64 {
-        self.budget.work()
-    }
-
-    fn set_variational(&mut self, on: bool) {
-        self.variational = on;
-    }
-
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
-        self.restart_in(tau, z.as_slice(), region);
-        self.forget_events();
-        Ok(())
-    }
+    current_fields!();
+    variational_fields!("adaptive");
 
     fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
         let tau0 = self.tau;
@@ -716,14 +689,6 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let tip = self.model.tip();
         let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
         [dot(&z.as_slice()[..n]), dot(&f[..n]), dot(&f[n..2 * n])]
-    }
-
-    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
-        self.last.jacobian.clone().ok_or(SimError::Unsupported {
-            integrator: "adaptive",
-            law: self.model.law_name(),
-            hint: "switch on the variational equations (Integrator::set_variational) first",
-        })
     }
 }
 

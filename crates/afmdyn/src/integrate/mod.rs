@@ -32,6 +32,70 @@
 //! at `tau_max`, or at an event (switching, impact, sticking, release), which it reports as a
 //! [`SwitchEvent`].
 
+/// The accessors [`Integrator::system`], [`Integrator::tau`], [`Integrator::state`] and
+/// [`Integrator::region`] of an integrator that keeps them in its fields `model`, `tau`, `z` and
+/// `region`.
+macro_rules! current_fields {
+    () => {
+        fn system(&self) -> &dyn TipSampleSystem {
+            &self.model
+        }
+        fn tau(&self) -> f64 {
+            self.tau
+        }
+        fn state(&self) -> &DVector<f64> {
+            &self.z
+        }
+        fn region(&self) -> Region {
+            self.region
+        }
+    };
+}
+
+/// What the adaptive and the Taylor integrators share beyond `current_fields!`: the name, the
+/// step budget's work (field `budget`), the switch of the variational equations (field
+/// `variational`), the reset (their `restart_in` and `forget_events`), and the last step's
+/// Jacobian (field `last.jacobian`, there only with the variational equations switched on).
+macro_rules! variational_fields {
+    ($name:literal) => {
+        fn name(&self) -> &'static str {
+            $name
+        }
+        fn work(&self) -> u64 {
+            self.budget.work()
+        }
+        fn set_variational(&mut self, on: bool) {
+            self.variational = on;
+        }
+        fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+            let (region, z) = self.model.checked_start(tau, z)?;
+            self.restart_in(tau, z.as_slice(), region);
+            self.forget_events();
+            Ok(())
+        }
+        fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+            self.last.jacobian.clone().ok_or(SimError::Unsupported {
+                integrator: $name,
+                law: self.model.law_name(),
+                hint: "switch on the variational equations (Integrator::set_variational) first",
+            })
+        }
+        fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+            match &self.last.jacobian {
+                Some(j) => {
+                    if out.shape() != j.shape() {
+                        *out = j.clone();
+                    } else {
+                        out.copy_from(j);
+                    }
+                    Ok(())
+                }
+                None => self.last_step_jacobian().map(|_| ()),
+            }
+        }
+    };
+}
+
 pub mod adaptive;
 pub(crate) mod dense;
 mod dop853;

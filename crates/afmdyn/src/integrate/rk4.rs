@@ -97,18 +97,7 @@ impl<S: TipSampleSystem + Clone> Rk4<S> {
 }
 
 impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
+    current_fields!();
     fn name(&self) -> &'static str {
         if self.locate {
             "rk4"

@@ -66,9 +66,8 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         // read a DMT modulus of 1e149 Pa)
         below: Some((1e-10, "below 0.1 nm, smaller than an atom: no continuum tip; probe files are in metres: 10 nm is 10e-9")),
         above: Some((1e-4, "longer than 100 µm for a tip radius; probe files are in metres: {x} nm is {x}e-9")),
-        magnitude: false,
         typical: Some((1e-9, 5e-5, "1 nm–50 µm of tips and colloidal probes", "radii are in m (10 nm is 10e-9)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["drive"],
@@ -79,9 +78,8 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         // lengths are in units of A₀: beyond 10 µm (a thousand times the tapping-mode amplitudes)
         // every tip–sample length vanishes against it (A₀ = 1 m ran for minutes; issue 27)
         above: Some((1e-5, "must be ≤ 1e-5 m (10 µm; tapping-mode amplitudes are nanometres)")),
-        magnitude: false,
         typical: Some((1e-11, 1e-6, "10 pm–1 µm of dynamic AFM", "amplitudes are in m (10 nm is 10e-9)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         // off-resonance (PeakForce) tapping: the z-modulation's frequency, 0.25–8 kHz on
@@ -92,9 +90,8 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         slips: &[("k", 1e3)],
         below: Some((1.0, "below 1 Hz for an off-resonance modulation; frequencies are in Hz: {x} kHz is {x}e3")),
         above: Some((1e6, "above 1 MHz, not off resonance for any lever; frequencies are in Hz")),
-        magnitude: false,
         typical: Some((100.0, 1e4, "0.1–10 kHz of off-resonance tapping", "frequencies are in Hz (2 kHz is 2e3)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         // the z-modulation's amplitude, 10–300 nm on commercial instruments
@@ -104,77 +101,56 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         slips: &[("n", 1e-9), ("µ", 1e-6)],
         below: Some((1e-10, "below 0.1 nm for an off-resonance modulation (probe files are in metres: 100 nm is 100e-9)")),
         above: Some((1e-5, "must be ≤ 1e-5 m (10 µm; off-resonance modulations are 10–300 nm)")),
-        magnitude: false,
         typical: Some((5e-9, 5e-7, "5–500 nm of off-resonance tapping", "amplitudes are in m (100 nm is 100e-9)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["intermolecular_distance"],
         unit: "m",
-        slips: &[],
-        below: None,
         above: Some((1e-6, "longer than 1 µm for a₀ (0.165e-9 m typical); probe files are in metres: {x} nm is {x}e-9")),
-        magnitude: false,
-        typical: None,
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["z_c"],
         unit: "m",
-        slips: &[],
-        below: None,
         above: Some((MAX_SI_DISTANCE, "longer than 100 µm for a rest distance; probe files are in metres: {x} nm is {x}e-9")),
         magnitude: true,
-        typical: None,
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["cantilever"],
         keys: &["length"],
         unit: "m",
         slips: &[("µ", 1e-6), ("m", 1e-3)],
-        below: None,
         above: Some((1e-2, "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6")),
-        magnitude: false,
         typical: Some((5e-6, 1e-3, "5 µm–1 mm of AFM levers", "lengths are in m (125 µm is 125e-6)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["cantilever"],
         keys: &["width", "thickness"],
         unit: "m",
-        slips: &[],
-        below: None,
         above: Some((1e-2, "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6")),
-        magnitude: false,
-        typical: None,
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["tip"],
         keys: &["youngs_modulus"],
         unit: "Pa",
-        slips: &[],
         below: Some((1e6, "below 1 MPa for a tip; moduli are in Pa: {x} GPa is {x}e9")),
-        above: None,
-        magnitude: false,
-        typical: None,
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["youngs_modulus"],
         unit: "Pa",
-        slips: &[],
         // hydrogels, brain tissue and cells reach 10 Pa and below (issue 77: two gel curves that
         // nanite fits at 56 and 73 Pa were held at a bound of 100 Pa)
         below: Some((1.0, "below 1 Pa (softer than the softest gels); moduli are in Pa: {x} MPa is {x}e6, {x} GPa is {x}e9")),
-        above: None,
-        magnitude: false,
         typical: Some((10.0, 1.2e12, "10 Pa–1.2 TPa of soft gels to diamond", "moduli are in Pa (4 GPa is 4e9)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         // the lever's resonance and the drive's frequency: the same range
@@ -184,9 +160,8 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         slips: &[("k", 1e3), ("M", 1e6)],
         below: Some((1e3, "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3")),
         above: Some((1e10, "above 10 GHz, beyond any cantilever; frequencies are in Hz")),
-        magnitude: false,
         typical: Some((1e3, 1e7, "1 kHz–10 MHz of AFM levers", "frequencies are in Hz (300 kHz is 300e3)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["cantilever"],
@@ -195,53 +170,45 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         slips: &[("m", 1e-3), ("k", 1e3)],
         below: Some((1e-6, "below 1 µN/m, softer than any lever; spring constants are in N/m")),
         above: Some((1e9, "above 1e9 N/m, stiffer than any sensor; spring constants are in N/m: {x} mN/m is {x}e-3")),
-        magnitude: false,
         typical: Some((5e-3, 1e6, "0.005–1e6 N/m of AFM levers, qPlus sensors and length-extension resonators", "stiffnesses are in N/m (40 N/m is 40.0)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["hamaker"],
         unit: "J",
-        slips: &[],
-        below: None,
         above: Some((1e-17, "above 1e-17 J (Hamaker constants are ~1e-20 J); in J: {x}e-20")),
-        magnitude: false,
         typical: Some((1e-21, 5e-19, "1e-21–5e-19 J of Hamaker constants", "they are in J (6.6e-20 J for polystyrene)")),
         zero_typical: true,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["surface_tension"],
         unit: "N/m",
         slips: &[("m", 1e-3)],
-        below: None,
         above: Some((1.0, "above 1 N/m, beyond any liquid (water 0.072 N/m, mercury 0.485 N/m); surface tensions are in N/m: {x} mN/m is {x}e-3")),
-        magnitude: false,
         typical: Some((0.01, 0.6, "0.01–0.6 N/m of liquids", "surface tensions are in N/m (water 0.072 N/m is 72e-3)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["sample"],
         keys: &["adhesion_energy"],
         unit: "J/m²",
         slips: &[("m", 1e-3)],
-        below: None,
         above: Some((10.0, "above 10 J/m², beyond any solid's work of adhesion (polymers 0.03–0.1 J/m², metals up to ~3 J/m²); in J/m²: {x} mJ/m² is {x}e-3")),
-        magnitude: false,
         typical: Some((1e-3, 1.0, "1e-3–1 J/m² of works of adhesion", "they are in J/m² (50 mJ/m² is 50e-3)")),
-        zero_typical: false,
+        ..SiRange::NONE
     },
     SiRange {
         sections: &["feedback"],
         keys: &["time_constant"],
         unit: "s",
         slips: &[("µ", 1e-6), ("m", 1e-3)],
-        below: None,
         above: Some((1e3, "above 1000 s for a lock-in's time constant (an imaging lock-in's is µs to ms); time constants are in s: {x} µs is {x}e-6")),
-        magnitude: false,
         typical: Some((1e-6, 0.1, "1 µs–0.1 s of imaging lock-ins", "time constants are in s (100 µs is 100e-6)")),
         zero_typical: true,
+        ..SiRange::NONE
     },
 ];
 
@@ -253,6 +220,20 @@ pub(crate) fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
 }
 
 impl SiRange {
+    /// The fields an entry of [`SI_RANGES`] leaves out: no slips, no physical or typical range,
+    /// the signed value compared, zero not typical.
+    const NONE: SiRange = SiRange {
+        sections: &[],
+        keys: &[],
+        unit: "",
+        slips: &[],
+        below: None,
+        above: None,
+        magnitude: false,
+        typical: None,
+        zero_typical: false,
+    };
+
     /// Why `x` is refused (outside the physical range: a unit slip rather than a measurement),
     /// or `None`.
     pub(crate) fn refusal(&self, x: f64) -> Option<String> {

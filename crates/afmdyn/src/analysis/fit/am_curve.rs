@@ -232,15 +232,43 @@ impl AmProbe {
     }
 }
 
-/// The model of a measured AM curve (module docs).
+/// The channels of a [`SteppedCurveModel`]: the AM curve's (amplitude, phase), the bimodal
+/// curve's (A₁, φ₁, A₂, φ₂) ([`super::bimodal_curve`]).
+pub trait Channels: Copy + std::fmt::Debug {
+    /// The further drive component whose harmonic is A₂, φ₂ (`None`: the first harmonic alone).
+    const COMPONENT: Option<usize>;
+    /// Which of (A₁, φ₁, A₂, φ₂) are the values, in that order.
+    fn fitted(&self) -> [bool; 4];
+    /// Refuse a probe or parameters the channels cannot be evaluated under (none for the AM
+    /// curve's).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming what is refused.
+    fn check(probe: &AmProbe, params: &[AmParam]) -> Result<(), SimError> {
+        let _ = (probe, params);
+        Ok(())
+    }
+}
+
+/// The amplitude and the phase: the values are the amplitudes, then the phases.
+impl Channels for (bool, bool) {
+    const COMPONENT: Option<usize> = None;
+    fn fitted(&self) -> [bool; 4] {
+        [self.0, self.1, false, false]
+    }
+}
+
+/// The model of a measured curve as the stepped approach of its rows (module docs): the AM
+/// curve's ([`AmCurveModel`]) or the bimodal channels'
+/// ([`super::bimodal_curve::BimodalCurveModel`]).
 #[derive(Debug)]
-pub struct AmCurveModel {
-    /// The probe.
+pub struct SteppedCurveModel<C> {
+    /// The probe (for the bimodal channels, its drive with a second component).
     pub probe: AmProbe,
     /// The piezo positions z (m) of the rows, in the order the instrument stepped.
     pub z: Vec<f64>,
-    /// Whether the amplitude and the phase are fitted (values: the amplitudes, then the phases).
-    pub channels: (bool, bool),
+    /// Which channels are fitted ([`Channels::fitted`]), in that order of the values.
+    pub channels: C,
     /// The model's parameters, in the fit's order.
     pub params: Vec<AmParam>,
     /// The stepped sweep's settings (its values are overwritten by the rows').
@@ -252,14 +280,17 @@ pub struct AmCurveModel {
     warnings: Mutex<Vec<String>>,
 }
 
-impl AmCurveModel {
+/// The model of a measured AM curve (module docs).
+pub type AmCurveModel = SteppedCurveModel<(bool, bool)>;
+
+impl<C: Channels> SteppedCurveModel<C> {
     /// A model of the rows `z` (m) under `probe`, with parameters `params` and the channels
-    /// (amplitude, phase).
-    pub fn new(probe: AmProbe, z: Vec<f64>, channels: (bool, bool), params: Vec<AmParam>) -> Self {
+    /// (amplitude, phase; or A₁, φ₁, A₂, φ₂).
+    pub fn new(probe: AmProbe, z: Vec<f64>, channels: C, params: Vec<AmParam>) -> Self {
         let mut spec = SteppedSpec::new(probe.params, SweepParam::Alpha5, Vec::new());
         spec.branches = false;
         let tolerance = SENSITIVITY_TOLERANCE;
-        AmCurveModel {
+        SteppedCurveModel {
             probe,
             z,
             channels,
@@ -273,11 +304,6 @@ impl AmCurveModel {
     /// The last evaluation's warnings (folds, grazing, rows off a period-1 orbit).
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
-    }
-
-    /// The parameters at `p` (SI, the model's order), z_offset, and the chain rule.
-    fn scaled(&self, p: &[f64]) -> (Params, f64, Chain) {
-        scaled(&self.probe, &self.params, p)
     }
 }
 
@@ -469,9 +495,12 @@ fn component_following(pr: &AmProbe, q: &mut Params) -> Option<f64> {
     derivative
 }
 
-impl CheckedModel for AmCurveModel {
+/// The values of the fitted channels at `p` (A g₀ in m, φ in deg), each channel's rows in turn,
+/// and with the Jacobian their sensitivities (rows off a stable period-1 orbit: the stepped
+/// sweep's observables, a zero Jacobian row); stops at the next row once `cancel` is set.
+impl<C: Channels> CheckedModel for SteppedCurveModel<C> {
     fn rows(&self) -> usize {
-        self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
+        self.z.len() * self.channels.fitted().iter().filter(|c| **c).count()
     }
     fn kept(&self) -> &Mutex<Vec<String>> {
         &self.warnings
@@ -483,9 +512,11 @@ impl CheckedModel for AmCurveModel {
         mut jacobian: Option<&mut [f64]>,
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
-        let (q, z_offset, chain) = self.scaled(p);
+        C::check(&self.probe, &self.params)?;
+        let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let g0 = self.probe.length_m;
         let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
+        let channels = self.channels.fitted();
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();
@@ -493,22 +524,39 @@ impl CheckedModel for AmCurveModel {
         let orbit_params = chain.orbit_params();
         let m = self.z.len();
         let n = self.params.len();
-        let (amp, ph) = self.channels;
-        let phase_row = if amp { m } else { 0 };
+        // each fitted channel's first value
+        let mut offset = [0usize; 4];
+        let mut next = 0;
+        for (c, on) in channels.iter().enumerate() {
+            offset[c] = next;
+            if *on {
+                next += m;
+            }
+        }
         let deg = 180.0 / std::f64::consts::PI;
+        let scale = [g0, deg, g0, deg];
         let mut warnings = Vec::new();
         let mut off = 0;
+        if let Some(j) = jacobian.as_deref_mut() {
+            j.fill(0.0);
+        }
         for (i, point) in first.iter().enumerate() {
             if cancel.load(Ordering::Relaxed) {
                 return Err(SimError::Cancelled);
             }
-            let mut a = point.observables.amplitude;
-            let mut phi = point.observables.phase;
-            let mut da = vec![0.0; n];
-            let mut dphi = vec![0.0; n];
+            let o = &point.observables;
+            let second = o.components.get(1);
+            let mut v = [
+                o.amplitude,
+                o.phase,
+                second.map_or(f64::NAN, |c| c.amplitude),
+                second.map_or(f64::NAN, |c| c.phase),
+            ];
+            let mut d = vec![vec![0.0; n]; 4];
+            let on_orbit = point.period == Some(1) && point.stable;
             // the values alone (the residuals) are the sweep's observables; with the Jacobian,
             // those of the sensitivities' Fourier integrals (the same to the integration error)
-            if jacobian.is_some() && point.period == Some(1) && point.stable {
+            if jacobian.is_some() && on_orbit {
                 let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
                 let s = orbit_sensitivity(
                     &model,
@@ -516,36 +564,39 @@ impl CheckedModel for AmCurveModel {
                     &point.state,
                     &orbit_params,
                     None,
-                    None,
+                    C::COMPONENT,
                 )?;
-                a = s.amplitude;
-                phi = s.phase;
                 for w in &s.warnings {
                     warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
                 }
                 // (gap, α4, H̃, α6, P̃) → (E_s, H, z_offset, R, c, W)
-                let map = |d: &[f64]| -> Vec<f64> {
-                    let si = |a: &AmParam| chain.to_si(&orbit_params, d, *a);
+                let map = |dd: &[f64]| -> Vec<f64> {
+                    let si = |a: &AmParam| chain.to_si(&orbit_params, dd, *a);
                     self.params.iter().map(si).collect()
                 };
-                da = map(&s.d_amplitude);
-                dphi = map(&s.d_phase);
-            } else if point.period != Some(1) || !point.stable {
+                (v[0], v[1]) = (s.amplitude, s.phase);
+                (d[0], d[1]) = (map(&s.d_amplitude), map(&s.d_phase));
+                if C::COMPONENT.is_some() {
+                    let two = s.component.as_ref().ok_or(SimError::NoConvergence {
+                        what: "the second component's harmonic",
+                        iterations: 0,
+                        residual: f64::NAN,
+                    })?;
+                    (v[2], v[3]) = (two.amplitude, two.phase);
+                    (d[2], d[3]) = (map(&two.d_amplitude), map(&two.d_phase));
+                }
+            } else if !on_orbit {
                 off += 1;
             }
-            if amp {
-                values[i] = a * g0;
-            }
-            if ph {
-                values[phase_row + i] = phi * deg;
-            }
-            if let Some(j) = jacobian.as_deref_mut() {
-                for k in 0..n {
-                    if amp {
-                        j[i * n + k] = da[k] * g0;
-                    }
-                    if ph {
-                        j[(phase_row + i) * n + k] = dphi[k] * deg;
+            for c in 0..4 {
+                if !channels[c] {
+                    continue;
+                }
+                let row = offset[c] + i;
+                values[row] = v[c] * scale[c];
+                if let Some(j) = jacobian.as_deref_mut() {
+                    for k in 0..n {
+                        j[row * n + k] = d[c][k] * scale[c];
                     }
                 }
             }

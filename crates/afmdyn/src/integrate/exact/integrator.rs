@@ -12,18 +12,7 @@ use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 
 impl Integrator for ExactPropagator {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
+    current_fields!();
     fn name(&self) -> &'static str {
         "exact"
     }

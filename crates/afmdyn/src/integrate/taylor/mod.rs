@@ -293,40 +293,14 @@ fn keep_jacobian(
 }
 
 impl Integrator for Taylor {
-    fn system(&self) -> &dyn TipSampleSystem {
-        &self.model
-    }
-    fn tau(&self) -> f64 {
-        self.tau
-    }
-    fn state(&self) -> &DVector<f64> {
-        &self.z
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
-    fn name(&self) -> &'static str {
-        "taylor"
-    }
-    fn work(&self) -> u64 {
-        self.budget.work()
-    }
-    fn set_variational(&mut self, on: bool) {
-        self.variational = on;
-    }
+    current_fields!();
+    variational_fields!("taylor");
     fn set_gap(&mut self, alpha5: f64) -> bool {
         if self.model.set_gap(alpha5).is_err() {
             return false;
         }
         self.jet.set_gap(alpha5);
         true
-    }
-
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
-        self.restart_in(tau, z.as_slice(), region);
-        self.forget_events();
-        Ok(())
     }
 
     fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
@@ -488,28 +462,6 @@ impl Integrator for Taylor {
             Some(self)
         } else {
             None
-        }
-    }
-
-    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
-        self.last.jacobian.clone().ok_or(SimError::Unsupported {
-            integrator: "taylor",
-            law: self.model.law_name(),
-            hint: "switch on the variational equations (Integrator::set_variational) first",
-        })
-    }
-
-    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
-        match &self.last.jacobian {
-            Some(j) => {
-                if out.shape() != j.shape() {
-                    *out = j.clone();
-                } else {
-                    out.copy_from(j);
-                }
-                Ok(())
-            }
-            None => self.last_step_jacobian().map(|_| ()),
         }
     }
 }
