@@ -21,7 +21,7 @@ use crate::params::MAX_MODES;
 ///
 /// # Panics
 /// If `i == 0`.
-pub fn beta_root(i: usize) -> f64 {
+pub(crate) fn beta_root(i: usize) -> f64 {
     assert!(i >= 1, "mode index starts at 1");
     let mut b = (2.0 * i as f64 - 1.0) * std::f64::consts::FRAC_PI_2;
     for _ in 0..60 {
@@ -38,7 +38,7 @@ pub fn beta_root(i: usize) -> f64 {
 
 /// One clamped–free mode: its wavenumber β and the coefficients of the stable form.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BeamMode {
+pub(crate) struct BeamMode {
     /// β_i, root of 1 + cos β cosh β = 0.
     pub beta: f64,
     /// σ_i = (cosh β + cos β)/(sinh β + sin β).
@@ -48,7 +48,7 @@ pub struct BeamMode {
 
 impl BeamMode {
     /// The i-th mode (i ≥ 1).
-    pub fn new(i: usize) -> Self {
+    pub(crate) fn new(i: usize) -> Self {
         let beta = beta_root(i);
         let e = (-beta).exp();
         let (s, c) = beta.sin_cos();
@@ -59,7 +59,7 @@ impl BeamMode {
     }
 
     /// The k-th derivative d^kφ/dξ^k at ξ ∈ [0, 1] (k = 0..=4; k = 4 gives β⁴φ).
-    pub fn derivative(&self, k: u32, xi: f64) -> f64 {
+    pub(crate) fn derivative(&self, k: u32, xi: f64) -> f64 {
         let b = self.beta;
         let x = b * xi;
         let grow = self.d * (-b * (1.0 - xi)).exp();
@@ -77,20 +77,20 @@ impl BeamMode {
     }
 
     /// φ(ξ).
-    pub fn value(&self, xi: f64) -> f64 {
+    pub(crate) fn value(&self, xi: f64) -> f64 {
         self.derivative(0, xi)
     }
 
     /// ∫₀¹ φ dξ = 2σ/β (closed form: the bracket of the antiderivative reduces to 2σ because
     /// 1 + cos β cosh β = 0).
-    pub fn integral(&self) -> f64 {
+    pub(crate) fn integral(&self) -> f64 {
         2.0 * self.sigma / self.beta
     }
 }
 
 /// The first N clamped–free modes with their tip values φ_i(1) and integrals ∫φ_i.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ModeShapes {
+pub(crate) struct ModeShapes {
     modes: Vec<BeamMode>,
 }
 
@@ -99,7 +99,7 @@ impl ModeShapes {
     ///
     /// # Panics
     /// If `n` is 0 or larger than `MAX_MODES`.
-    pub fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         assert!((1..=MAX_MODES).contains(&n), "modes must be in 1..=20");
         ModeShapes {
             modes: (1..=n).map(BeamMode::new).collect(),
@@ -107,17 +107,17 @@ impl ModeShapes {
     }
 
     /// The modes, index 0 = mode 1.
-    pub fn modes(&self) -> &[BeamMode] {
+    pub(crate) fn modes(&self) -> &[BeamMode] {
         &self.modes
     }
 
     /// φ_i(ξ) for all i: shape `[N]`.
-    pub fn values(&self, xi: f64) -> Vec<f64> {
+    pub(crate) fn values(&self, xi: f64) -> Vec<f64> {
         self.modes.iter().map(|m| m.value(xi)).collect()
     }
 
     /// Tip values φ_i(1): shape `[N]`.
-    pub fn tip(&self) -> Vec<f64> {
+    pub(crate) fn tip(&self) -> Vec<f64> {
         self.values(1.0)
     }
 

@@ -3,7 +3,7 @@
 //! (each entry with its source). A probe file names one with `[cantilever] name = "…"`; the
 //! entry fills the keys the file leaves out (`fill`): `spring_constant`,
 //! `resonance_frequency`, `quality_factor`, `[tip].radius`, the tip's elastic constants
-//! (silicon, [`SILICON_YOUNGS_MODULUS`], `SILICON_POISSON_RATIO`) and `model =
+//! (silicon, `SILICON_YOUNGS_MODULUS`, `SILICON_POISSON_RATIO`) and `model =
 //! "point-mass"`. The file's own keys always win; a spring constant or resonance frequency
 //! beyond the maker's spread of the named lever's warns (`calibration_warnings`).
 
@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 /// ([`crate::units::SILICON_TIP`]: 130 GPa along ⟨100⟩, the lower end of 130–188 GPa over
 /// orientations; Hopcroft, Nix & Kenny, "What is the Young's modulus of silicon?", J.
 /// Microelectromech. Syst. 19, 229 (2010)).
-pub const SILICON_YOUNGS_MODULUS: f64 = crate::units::SILICON_TIP.youngs_modulus;
+pub(crate) const SILICON_YOUNGS_MODULUS: f64 = crate::units::SILICON_TIP.youngs_modulus;
 /// Poisson's ratio of a silicon tip, from the one materials table
 /// ([`crate::units::SILICON_TIP`]: 0.27, the paper's).
 pub(crate) const SILICON_POISSON_RATIO: f64 = crate::units::SILICON_TIP.poisson_ratio;

@@ -191,7 +191,7 @@ macro_rules! laws {
             /// The long-range attraction at tip–sample distance d > 0: [F(d), dF/dd, U(d)] with
             /// F = −dU/dd (`Law::long_range`); zeros for the laws without one.
             fn long_range(d: f64) -> [f64; 3];
-            /// A hysteretic law's cycle ([`ContactLaw::release_distance`] > 0) in the law's
+            /// A hysteretic law's cycle (`ContactLaw::release_distance` > 0) in the law's
             /// units, with Hertz group `alpha4`: where the contact is left, the largest pull and
             /// the energy each tap loses to the hysteresis; `None` for the other laws.
             fn hysteresis(alpha4: f64) -> Option<Hysteresis>;
@@ -329,7 +329,7 @@ pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VACUUM_PERMITTIVITY};
 pub use jkr::{Jkr, PreparedJkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
 pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
-pub(crate) use prepared::{AsGiven, PreparedForce, PreparedLaw};
+pub use prepared::{AsGiven, PreparedForce, PreparedLaw};
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {
@@ -388,7 +388,7 @@ impl ContactLaw {
     /// for 0 < V_T < |δ_f| the region depends on the history, and [`crate::CantileverModel`]
     /// takes a start there as in contact when the tip moves away from the sample (leaving
     /// through its neck) and free when it moves towards it (approaching).
-    pub fn release_distance(&self, alpha4: f64) -> f64 {
+    pub(crate) fn release_distance(&self, alpha4: f64) -> f64 {
         self.hysteresis(alpha4).map_or(0.0, |h| h.release_distance)
     }
 }

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 /// Undamped natural frequencies of one region: K x = ω² M x (homogeneous eq. 19 with C = 0).
 #[derive(Debug, Clone, PartialEq)]
-pub struct NaturalModes {
+pub(crate) struct NaturalModes {
     /// ω_i ascending, shape `[N]` (dimensionless, eq. 5 time scale).
     pub omega: Vec<f64>,
     /// Mode vectors as columns (N×N), mass-normalised: xᵀ M x = 1.
@@ -18,7 +18,7 @@ pub struct NaturalModes {
 /// Solve the generalised symmetric problem K x = ω² M x through the Cholesky factor of M
 /// (M = L Lᵀ, symmetric eigenproblem of L⁻¹ K L⁻ᵀ). The defining identity K x = ω² M x is
 /// what the tests assert.
-pub fn natural_modes(m: &RegionMatrices) -> NaturalModes {
+pub(crate) fn natural_modes(m: &RegionMatrices) -> NaturalModes {
     let chol = m
         .mass
         .clone()
@@ -85,7 +85,11 @@ pub(crate) fn beam_damping_for_q(
 ///
 /// # Panics
 /// For k ≥ N.
-pub fn mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>, k: usize) -> (f64, DVector<f64>, f64) {
+pub(crate) fn mode_at_tip(
+    m: &RegionMatrices,
+    tip: &DVector<f64>,
+    k: usize,
+) -> (f64, DVector<f64>, f64) {
     let modes = natural_modes(m);
     let x: DVector<f64> = modes.vectors.column(k).into_owned();
     let w = modes.omega[k];
@@ -124,7 +128,7 @@ pub struct DampedEigenvalue {
 ///
 /// Each underdamped mode appears once (its Im > 0 member of the conjugate pair); an overdamped
 /// mode contributes its two real eigenvalues (Im = 0), listed first.
-pub fn damped_eigenvalues(m: &RegionMatrices) -> Vec<DampedEigenvalue> {
+pub(crate) fn damped_eigenvalues(m: &RegionMatrices) -> Vec<DampedEigenvalue> {
     let a = state_matrix_eq21(m);
     let scale = a.norm().max(1.0);
     let ev: DVector<Complex<f64>> = a.complex_eigenvalues();
@@ -184,7 +188,7 @@ pub struct RegionSpectrum {
 ///
 /// # Errors
 /// [`ParamError`] if `params` is invalid.
-pub fn spectrum(params: &Params) -> Result<(RegionSpectrum, RegionSpectrum), ParamError> {
+pub(crate) fn spectrum(params: &Params) -> Result<(RegionSpectrum, RegionSpectrum), ParamError> {
     let g = Galerkin::new(params)?;
     let one = |r| {
         let m = g.region(r);
@@ -215,7 +219,7 @@ pub struct Fig3Point {
 ///
 /// # Errors
 /// [`ParamError`] if a grid value is invalid (negative α's, N out of range).
-pub fn fig3_sweep(
+pub(crate) fn fig3_sweep(
     modes: usize,
     alpha1: &[f64],
     alpha4: &[f64],

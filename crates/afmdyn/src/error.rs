@@ -147,7 +147,7 @@ fn number_text(value: &str) -> String {
 
 /// The operating system's reason of an I/O error in words (`No space left on device`, without
 /// the `(os error 28)` of its `Display`), and for an error that only has a kind the kind's
-/// words ([`io_kind_message`]).
+/// words (`io_kind_message`).
 pub fn io_message(e: &std::io::Error) -> String {
     if e.raw_os_error().is_some() {
         let text = e.to_string();
@@ -164,7 +164,7 @@ pub fn io_message(e: &std::io::Error) -> String {
 
 /// An I/O error kind in words, as the operating system says it where it has the kind's
 /// errno (`StorageFull` is "no space left on device"), else the standard library's words.
-pub fn io_kind_message(kind: std::io::ErrorKind) -> String {
+pub(crate) fn io_kind_message(kind: std::io::ErrorKind) -> String {
     use std::io::ErrorKind as K;
     match kind {
         K::StorageFull => "no space left on device".into(),
@@ -364,7 +364,7 @@ impl SimError {
     }
 
     /// Shorthand for [`SimError::OutOfRange`].
-    pub fn out_of_range(
+    pub(crate) fn out_of_range(
         name: &'static str,
         value: impl ToString,
         allowed: impl Into<std::borrow::Cow<'static, str>>,

@@ -11,11 +11,11 @@ use crate::params::{Params, Structure, SweepParam};
 use nalgebra::{DMatrix, DVector};
 
 /// The two regions (the modes of the hybrid system), defined with it in [`crate::system`].
-pub use crate::system::Region;
+pub(crate) use crate::system::Region;
 
 /// Modal forcing F_s(τ) = `constant` + `sin` · sin Ωτ + `cos` · cos Ωτ, each of shape `[N]`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Forcing {
+pub(crate) struct Forcing {
     /// Constant part.
     pub constant: DVector<f64>,
     /// Coefficient of sin Ωτ.
@@ -26,7 +26,7 @@ pub struct Forcing {
 
 /// Galerkin matrices of one region (eq. 10): mass, damping, stiffness (N×N) and forcing.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RegionMatrices {
+pub(crate) struct RegionMatrices {
     /// Mass matrix M (eq. 11 / eq. 15).
     pub mass: DMatrix<f64>,
     /// Damping matrix C_s (eq. 12 or eq. 16).
@@ -39,7 +39,7 @@ pub struct RegionMatrices {
 
 /// The Galerkin discretisation of the paper's model for one parameter set.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Galerkin {
+pub(crate) struct Galerkin {
     params: Params,
     shapes: ModeShapes,
     tip: DVector<f64>,
@@ -54,7 +54,7 @@ impl Galerkin {
     /// # Errors
     /// [`ParamError`] if `params` fails validation (`Params::validate_fields`: the matrices do
     /// not depend on the drive's common period).
-    pub fn new(params: &Params) -> Result<Self, ParamError> {
+    pub(crate) fn new(params: &Params) -> Result<Self, ParamError> {
         params.validate_fields()?;
         let n = params.modes;
         let shapes = ModeShapes::new(n);
@@ -120,17 +120,17 @@ impl Galerkin {
     }
 
     /// The clamped–free mode shapes.
-    pub fn shapes(&self) -> &ModeShapes {
+    pub(crate) fn shapes(&self) -> &ModeShapes {
         &self.shapes
     }
 
     /// Tip values φ_i(1), shape `[N]`.
-    pub fn tip(&self) -> &DVector<f64> {
+    pub(crate) fn tip(&self) -> &DVector<f64> {
         &self.tip
     }
 
     /// Matrices of one region.
-    pub fn region(&self, r: Region) -> &RegionMatrices {
+    pub(crate) fn region(&self, r: Region) -> &RegionMatrices {
         match r {
             Region::Free => &self.free,
             Region::Contact => &self.contact,

@@ -27,7 +27,7 @@
 //!
 //! A probe's `[medium]` loads every mode of the model with its added mass and damping at its
 //! own wet frequency ([`crate::params::Hydrodynamic`], set by the probe reader's `medium`
-//! part); [`Section::mode_at`] inverts the wet mode in closed form, which brings a lever's
+//! part); `Section::mode_at` inverts the wet mode in closed form, which brings a lever's
 //! values measured in air back to vacuum.
 
 use crate::error::{SimError, UnitsError};
@@ -57,13 +57,13 @@ impl Medium {
     /// Water at 25 °C: ρ = 997.05 kg/m³, η = 0.890 mPa s (CRC Handbook of Chemistry and
     /// Physics, 97th ed., 2016, §6, "Properties of water in the range 0–100 °C" and
     /// "Viscosity of liquids").
-    pub const WATER: Medium = Medium {
+    pub(crate) const WATER: Medium = Medium {
         density: 997.05,
         viscosity: 8.90e-4,
     };
     /// Dry air at 25 °C and 101.325 kPa: ρ = 1.184 kg/m³, η = 18.49 µPa s (CRC Handbook, 97th
     /// ed., §6, "Properties of air" and "Viscosity of gases").
-    pub const AIR: Medium = Medium {
+    pub(crate) const AIR: Medium = Medium {
         density: 1.184,
         viscosity: 1.849e-5,
     };
@@ -78,7 +78,7 @@ impl Medium {
     ///
     /// # Errors
     /// [`UnitsError::Positive`] naming the field.
-    pub fn validate(&self) -> Result<(), UnitsError> {
+    pub(crate) fn validate(&self) -> Result<(), UnitsError> {
         positive("medium.density", self.density, "kg/m^3")?;
         positive("medium.viscosity", self.viscosity, "Pa s")?;
         Ok(())
@@ -86,7 +86,7 @@ impl Medium {
 
     /// The Reynolds number Re = ρωb²/(4η) of a beam of width `width` (m) vibrating at angular
     /// frequency `omega` (rad/s) (module docs).
-    pub fn reynolds(&self, omega: f64, width: f64) -> f64 {
+    pub(crate) fn reynolds(&self, omega: f64, width: f64) -> f64 {
         self.density * omega * width * width / (4.0 * self.viscosity)
     }
 }
@@ -139,7 +139,7 @@ fn check_reynolds(re: f64) -> Result<f64, SimError> {
 /// # Errors
 /// [`SimError::OutOfRange`] for Re outside [`MIN_REYNOLDS`, `MAX_REYNOLDS`] (or not
 /// finite); [`SimError::OutOfRange`] naming `bessel` should the Bessel functions fail.
-pub fn gamma_circular(re: f64) -> Result<Complex<f64>, SimError> {
+pub(crate) fn gamma_circular(re: f64) -> Result<Complex<f64>, SimError> {
     let re = check_reynolds(re)?;
     let i = Complex::<f64>::i();
     let z = -i * (i * re).sqrt();
@@ -183,7 +183,7 @@ pub(crate) fn rectangular_correction(re: f64) -> Result<Complex<f64>, SimError> 
 ///
 /// # Errors
 /// As [`gamma_circular`].
-pub fn gamma_rectangular(re: f64) -> Result<Complex<f64>, SimError> {
+pub(crate) fn gamma_rectangular(re: f64) -> Result<Complex<f64>, SimError> {
     Ok(rectangular_correction(re)? * gamma_circular(re)?)
 }
 
@@ -216,7 +216,7 @@ pub struct Section {
 
 impl Section {
     /// The section of a rectangular beam (its width, thickness and density).
-    pub(crate) fn of(beam: &Cantilever) -> Section {
+    pub fn of(beam: &Cantilever) -> Section {
         Section {
             width: beam.width,
             mass_per_length: beam.mass_per_length(),
@@ -244,7 +244,11 @@ impl Section {
     ///
     /// # Errors
     /// As `wet_mode_of`.
-    pub fn mode_at(&self, frequency_hz: f64, medium: &Medium) -> Result<(WetMode, f64), SimError> {
+    pub(crate) fn mode_at(
+        &self,
+        frequency_hz: f64,
+        medium: &Medium,
+    ) -> Result<(WetMode, f64), SimError> {
         self.validate()?;
         medium.validate()?;
         positive("frequency_hz", frequency_hz, "Hz")?;

@@ -7,7 +7,7 @@
 //! damper α6 that act while the tip displacement V_T (eq. 8) is ≤ 0 (gap α5).
 //!
 //! The tree follows the paper:
-//! [`beam`] (mode shapes) → [`galerkin`] (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
+//! `beam` (mode shapes) → `galerkin` (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
 //! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
 //! saltation) → [`model`] (the cantilever–sample system) → [`tip_sample`] (what integrators and
 //! analyses need of a probe over a sample) → [`integrate`] (exact propagation, RK4, the
@@ -46,7 +46,7 @@
 //!   and files), [`study`] (the stores that resume), [`probe`], [`cantilevers`], [`units`],
 //!   [`hydro`], [`io`] and [`error`].
 //! * The model and the algorithms — [`params`], [`model`], [`contact`], [`integrate`], [`maps`],
-//!   [`analysis`], [`trajectory`], [`system`], [`tip_sample`], [`beam`], [`galerkin`],
+//!   [`analysis`], [`trajectory`], [`system`], [`tip_sample`], `beam`, `galerkin`,
 //!   [`eigen`] and the re-exports below — are public for use as a library (the example above),
 //!   the examples and the benchmarks.
 //! * The integration tests (`crates/afmdyn/tests/main.rs` and its modules) are compiled inside
@@ -78,12 +78,12 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
-pub mod beam;
+pub(crate) mod beam;
 pub mod cantilevers;
 pub mod contact;
 pub mod eigen;
 pub mod error;
-pub mod galerkin;
+pub(crate) mod galerkin;
 pub mod hydro;
 pub mod integrate;
 pub mod io;

@@ -31,7 +31,7 @@ use nalgebra::{DMatrix, DVector};
 mod body_contact;
 mod rate_form;
 
-pub use body_contact::{weighted_displacement, BodyContactCheck};
+pub(crate) use body_contact::{weighted_displacement, BodyContactCheck};
 pub(crate) use rate_form::RateForm;
 
 /// A chattering sequence ends in sticking when the next bounce would rise less than this many
@@ -86,7 +86,7 @@ pub(crate) struct DampingDerivative {
 
 /// Rates of the energy balance dE/dτ = P_base − D_beam − D_contact (see [`CantileverModel::power`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PowerTerms {
+pub(crate) struct PowerTerms {
     /// Power of the base motion: ȦᵀF^I(τ) (inertial drive in the clamped frame, eq. 14) minus
     /// α2 Ω cos Ωτ · F_c (the sample is fixed while the clamped frame moves).
     pub base: f64,
@@ -226,7 +226,7 @@ impl CantileverModel {
     /// V_T at which the contact region is left on retraction: |δ_f| > 0 for a hysteretic law
     /// (JKR's neck, [`ContactLaw::release_distance`]), 0 otherwise. The contact guard is
     /// g = release − V_T.
-    pub fn release_distance(&self) -> f64 {
+    pub(crate) fn release_distance(&self) -> f64 {
         self.release
     }
 
@@ -258,7 +258,7 @@ impl CantileverModel {
     /// As [`CantileverModel::new`]: `Params::validate_fields` of the changed parameters (the
     /// drive's common period, [`Params::validate`]'s further check, does not depend on α5);
     /// the model is unchanged then.
-    pub fn set_gap(&mut self, alpha5: f64) -> Result<(), ParamError> {
+    pub(crate) fn set_gap(&mut self, alpha5: f64) -> Result<(), ParamError> {
         self.params
             .with(SweepParam::Alpha5, alpha5)
             .validate_fields()?;
@@ -278,7 +278,7 @@ impl CantileverModel {
         &self.params
     }
     /// The tip–sample law.
-    pub fn law(&self) -> &ContactLaw {
+    pub(crate) fn law(&self) -> &ContactLaw {
         &self.params.contact_law
     }
     /// Number of modes N.
@@ -291,7 +291,7 @@ impl CantileverModel {
     }
     /// The SLS sample whose dashpot extension u is the state's entry 2N (`None` for the other
     /// laws).
-    pub fn zener(&self) -> Option<&Zener> {
+    pub(crate) fn zener(&self) -> Option<&Zener> {
         self.zener.as_ref()
     }
     /// The SLS sample's (zener, u) at z, `None` for the other laws.
@@ -317,7 +317,7 @@ impl CantileverModel {
         self.period
     }
     /// The Galerkin matrices.
-    pub fn galerkin(&self) -> &Galerkin {
+    pub(crate) fn galerkin(&self) -> &Galerkin {
         &self.galerkin
     }
     /// Tip values φ_j(1), shape `[N]`.
@@ -325,11 +325,11 @@ impl CantileverModel {
         self.galerkin.tip()
     }
     /// M⁻¹φ(1), shape `[N]`: the modal acceleration per unit tip force.
-    pub fn tip_mobility(&self) -> &DVector<f64> {
+    pub(crate) fn tip_mobility(&self) -> &DVector<f64> {
         &self.mphi
     }
     /// Modal mass at the tip m_eff = 1/(φᵀM⁻¹φ).
-    pub fn effective_mass(&self) -> f64 {
+    pub(crate) fn effective_mass(&self) -> f64 {
         self.m_eff
     }
     /// First-order dynamics of a region for the **linear law** (eqs. 10, 15–18): the affine
@@ -397,7 +397,7 @@ impl CantileverModel {
 
     /// Tip force F_c (repulsive positive) in region r at (τ, z): the law's force, or in the
     /// sticking region of the impact law the constraint force λ.
-    pub fn contact_force(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
+    pub(crate) fn contact_force(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
         let sc = (self.params.omega * tau).sin_cos();
         self.tip_force_with(r, tau, sc, z.as_slice())
     }
@@ -581,7 +581,7 @@ impl CantileverModel {
         self.w_tip_slice(z.as_slice(), 0)
     }
     /// Tip velocity ∂W(1,τ)/∂τ.
-    pub fn w_tip_dot(&self, z: &DVector<f64>) -> f64 {
+    pub(crate) fn w_tip_dot(&self, z: &DVector<f64>) -> f64 {
         self.w_tip_slice(z.as_slice(), self.modes())
     }
     /// Switching function V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8).
@@ -590,7 +590,7 @@ impl CantileverModel {
     }
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at τ from the tip deflection and its derivatives
     /// [W(1,τ), W', W''] (eq. 8 differentiated twice).
-    pub fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
+    pub(crate) fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
         self.v_t_at(self.base_trig(tau), w)
     }
     /// (sin Ωτ, cos Ωτ) as V_T needs them (eq. 8): without the sine and cosine where the base
@@ -614,23 +614,24 @@ impl CantileverModel {
     }
     /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at (τ, z), `z: [f64; 2N]` as (a, ȧ): the tip
     /// deflection and rate (eq. 9 at ξ = 1) and eq. 8 from one sin/cos Ωτ.
-    pub fn tip_values(&self, tau: f64, z: &DVector<f64>) -> [f64; 4] {
+    pub(crate) fn tip_values(&self, tau: f64, z: &DVector<f64>) -> [f64; 4] {
         let (w, w_dot) = (self.w_tip(z), self.w_tip_dot(z));
         let [v_t, v_t_dot, _] = self.v_t_from_tip(tau, [w, w_dot, 0.0]);
         [w, w_dot, v_t, v_t_dot]
     }
     /// dV_T/dτ = ∂W(1,τ)/∂τ + α2 Ω cos Ωτ.
-    pub fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
+    pub(crate) fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
         self.v_t_from_tip(tau, [0.0, self.w_tip_dot(z), 0.0])[1]
     }
     /// Region by the sign of V_T: contact when V_T ≤ 0 (eq. 10; V_T + s(u) ≤ 0 over the SLS
     /// sample's recovering surface). (For the impact law, sticking is tracked by the
     /// integrators; see [`HybridSystem::mode_at`].)
-    pub fn region_at(&self, tau: f64, z: &DVector<f64>) -> Region {
+    pub(crate) fn region_at(&self, tau: f64, z: &DVector<f64>) -> Region {
         Region::of_v_t(self.switching(self.v_t(tau, z), z.as_slice()))
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
     /// For the point-mass and eigenmode models, the tip deflection Σ z_j at every ξ.
+    #[cfg(test)]
     pub fn deflection(&self, xi: f64, z: &DVector<f64>) -> f64 {
         if self.params.structure.is_lumped() {
             return z.rows(0, self.modes()).sum();
@@ -725,7 +726,7 @@ impl CantileverModel {
     ///
     /// # Errors
     /// [`SimError::StateLength`] / [`SimError::NotFinite`].
-    pub fn state_from(&self, a: &[f64], a_dot: &[f64]) -> Result<DVector<f64>, SimError> {
+    pub(crate) fn state_from(&self, a: &[f64], a_dot: &[f64]) -> Result<DVector<f64>, SimError> {
         let n = self.modes();
         for (name, v) in [
             ("initial modal displacements", a),

@@ -20,20 +20,20 @@ const _: () = assert!(
 
 /// Largest tip-mass ratio α1: the mass matrix I + α1 φ(1)φ(1)ᵀ has condition number ≈ 4Nα1, and
 /// beyond 10⁴ beam masses its Cholesky factor (used by every integrator) loses too many digits.
-pub const ALPHA1_MAX: f64 = 1e4;
+pub(crate) const ALPHA1_MAX: f64 = 1e4;
 /// Largest drive amplitude α2 and gap |α5|: displacements scale with them, and the integrators
 /// stop as diverged at a state norm of `STATE_NORM_MAX`; beyond 10⁶ products such as the
 /// squared gap in the contact energy leave the range where the switching search is reliable.
-pub const DISPLACEMENT_MAX: f64 = 1e6;
+pub(crate) const DISPLACEMENT_MAX: f64 = 1e6;
 /// Largest damping coefficients α3 and α6: the damping rate sets the stiffness of the system,
 /// and the exact grid needs about α·T steps per drive period (see `GRID_BUDGET_BYTES`).
-pub const DAMPING_MAX: f64 = 1e4;
+pub(crate) const DAMPING_MAX: f64 = 1e4;
 /// Largest contact stiffness α4: contact frequencies grow as √(4Nα4); beyond 10⁸ the contact
 /// system is both stiff and ill-conditioned.
-pub const ALPHA4_MAX: f64 = 1e8;
+pub(crate) const ALPHA4_MAX: f64 = 1e8;
 /// Smallest drive frequency Ω: below it one drive period spans more than ~10⁴ oscillations of
 /// the first mode, a grid far beyond `GRID_BUDGET_BYTES` for any N > 1.
-pub const OMEGA_MIN: f64 = 1e-3;
+pub(crate) const OMEGA_MIN: f64 = 1e-3;
 /// Smallest modulation frequency Ω = f_m/f₀ of a moving sample ([`Excitation::Sample`],
 /// off-resonance tapping): f₀/f_m up to 10⁵ is physical (a 300 kHz lever under a 1–8 kHz
 /// PeakForce modulation is 40–300; a 2 MHz lever at 250 Hz is 8 000), and the modulation
@@ -45,7 +45,7 @@ pub(crate) const OMEGA_MIN_MODULATED: f64 = 1e-5;
 /// Largest drive frequency Ω: above it the inertial drive α2Ω² is so much larger than the
 /// response that the result is round-off (the per-period energy balance fails, 1e-7 relative at
 /// Ω = 1e8), and Ω is far above the highest Galerkin mode the model resolves (N ≤ 20).
-pub const OMEGA_MAX: f64 = 1e5;
+pub(crate) const OMEGA_MAX: f64 = 1e5;
 /// States with ‖z‖₂ at or above this are treated as diverged by the integrators; an initial
 /// state must lie below it.
 pub(crate) const STATE_NORM_MAX: f64 = 1e12;
@@ -62,7 +62,7 @@ pub(crate) const ADAPTIVE_STEPS_BUDGET: f64 = 1e7;
 /// by a strong DMT adhesion needs ~3e5 steps per period, ~2 s, where the default Hertz orbit
 /// needs ~200). 1e5 steps (~1 s at N = 3) is 500× the default's; beyond, the run ends with
 /// [`crate::SimError::Budget`] naming what to change, rather than running for hours.
-pub const ADAPTIVE_STEPS_PER_PERIOD: usize = 100_000;
+pub(crate) const ADAPTIVE_STEPS_PER_PERIOD: usize = 100_000;
 
 /// Dimensionless model parameters (paper eq. 7), all in the units of eq. 5.
 ///
@@ -78,7 +78,7 @@ pub const ADAPTIVE_STEPS_PER_PERIOD: usize = 100_000;
 /// | `omega` | Ω | drive frequency (dimensionless) | 1e-3 ..= 1e5 |
 /// | `contact_law` | F_c(δ, δ̇) | tip–sample law and its groups ([`ContactLaw`]) | see the law |
 ///
-/// The upper limits are where the numerics stop being meaningful (see [`ALPHA1_MAX`] and the
+/// The upper limits are where the numerics stop being meaningful (see `ALPHA1_MAX` and the
 /// other constants of this module for the reason of each).
 ///
 /// α4 and α6 are the stiffness and damping groups of whichever law is chosen (the Hertz group
@@ -323,7 +323,7 @@ pub struct DriveComponent {
 
 impl DriveComponent {
     /// The component's frequency ratio p/q to Ω.
-    pub fn ratio(&self) -> f64 {
+    pub(crate) fn ratio(&self) -> f64 {
         f64::from(self.ratio[0]) / f64::from(self.ratio[1])
     }
     /// The component's period in periods 2π/Ω: q/gcd(p, q).
@@ -628,7 +628,7 @@ impl Params {
     /// moving sample ([`Excitation::Sample`], any structure: the tip–sample distance carries
     /// the same sinusoid), 0 for a force drive (`Params::is_force_driven`: the lumped models,
     /// the beam with [`Excitation::Tip`]), whose base does not move. Every V_T formula uses this.
-    pub fn base_amplitude(&self) -> f64 {
+    pub(crate) fn base_amplitude(&self) -> f64 {
         if self.is_force_driven() {
             0.0
         } else {
@@ -652,7 +652,7 @@ impl Params {
     /// Phase ψ of the drive: the drive is ∝ sin(Ωτ + ψ), ψ = 0 for the base drive (base
     /// displacement α2 sin Ωτ) and π/2 for a force drive (force α2 cos Ωτ). Phases of the response
     /// are measured as lags behind it.
-    pub fn drive_phase(&self) -> f64 {
+    pub(crate) fn drive_phase(&self) -> f64 {
         if self.is_force_driven() {
             std::f64::consts::FRAC_PI_2
         } else {

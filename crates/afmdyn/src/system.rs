@@ -41,7 +41,7 @@ impl Region {
     }
 
     /// The other region.
-    pub fn other(self) -> Region {
+    pub(crate) fn other(self) -> Region {
         match self {
             Region::Free => Region::Contact,
             Region::Contact => Region::Free,
@@ -50,7 +50,7 @@ impl Region {
 
     /// Sign σ of the guard g = σ V_T of a region of the smooth laws: +1 in free flight (left
     /// when V_T falls to 0), −1 in contact (left when V_T rises to 0).
-    pub fn guard_sign(self) -> f64 {
+    pub(crate) fn guard_sign(self) -> f64 {
         match self {
             Region::Free => 1.0,
             Region::Contact => -1.0,
@@ -110,7 +110,7 @@ pub struct Jump {
 
 impl Jump {
     /// A plain switching to `to`: z⁺ = z⁻.
-    pub fn switching(to: Region, z: &[f64]) -> Jump {
+    pub(crate) fn switching(to: Region, z: &[f64]) -> Jump {
         let d = z.len();
         Jump {
             to,
@@ -266,7 +266,7 @@ pub fn saltation<S: HybridSystem + ?Sized>(
 /// w (∂g/∂p) δp: the sensitivity s = ∂z/∂p crosses the event as s⁺ = S s⁻ + w ∂g/∂p (the
 /// parameter column of the saltation matrix of the system extended by ṗ = 0; Leine &
 /// Nijmeijer 2004, §7.1, with p as a state).
-pub(crate) fn saltation_with_shift<S: HybridSystem + ?Sized>(
+pub fn saltation_with_shift<S: HybridSystem + ?Sized>(
     sys: &S,
     from: Region,
     tau: f64,
@@ -282,7 +282,7 @@ pub(crate) fn saltation_with_shift<S: HybridSystem + ?Sized>(
 /// apply it without forming it: S M = R M + w (∇_z gᵀ M) is a rank-one update of R M, and R = I
 /// at a switching.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SaltationParts {
+pub(crate) struct SaltationParts {
     /// The jump (with R = ∂z⁺/∂z⁻).
     pub jump: Jump,
     /// ∇_z g of the guard left, shape `[d]`.
@@ -295,7 +295,7 @@ impl SaltationParts {
     /// M ← S M for M of d rows (column-major `m`, any number of whole columns: the monodromy
     /// matrix, or one sensitivity vector; a trailing partial column is left alone). Allocates
     /// nothing at a switching (R = I), one column of scratch otherwise.
-    pub fn apply(&self, m: &mut [f64]) {
+    pub(crate) fn apply(&self, m: &mut [f64]) {
         let d = self.shift.len();
         let identity = self.jump.kind == EventKind::Switching;
         let mut scratch = if identity { Vec::new() } else { vec![0.0; d] };
@@ -314,7 +314,7 @@ impl SaltationParts {
 
 /// The parts R, ∇_z g and w of the saltation matrix of the event of mode `from` at (τ, z⁻)
 /// (module docs; w as in `saltation_with_shift`, zero when ġ = 0).
-pub fn saltation_parts<S: HybridSystem + ?Sized>(
+pub(crate) fn saltation_parts<S: HybridSystem + ?Sized>(
     sys: &S,
     from: Region,
     tau: f64,

@@ -19,7 +19,7 @@
 //! ([`TipSampleSystem::body_contact_check`]); a system without them gets the floors and no
 //! check. The two analyses that need the cantilever's Galerkin structure itself — the AFM
 //! observables (energy balance, virial over the modes, SI scales) and the recorded trajectory
-//! with its energy quadrature — ask for it with [`require_cantilever`] and refuse another
+//! with its energy quadrature — ask for it with `require_cantilever` and refuse another
 //! system with [`SimError::NotCantilever`].
 
 use crate::eigen::damped_eigenvalues;
@@ -95,7 +95,7 @@ pub trait TipSampleSystem: HybridSystem {
     /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for a parameter p of the forcing (Ω, α2,
     /// α5), or `None` where the system does not provide it (the default): the parameter
     /// sensitivity of a flow then is not available
-    /// ([`crate::maps::flow::flow`]).
+    /// (`crate::maps::flow::flow`).
     fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
         let _ = (mode, param, tau);
         None
@@ -103,7 +103,7 @@ pub trait TipSampleSystem: HybridSystem {
     /// Name of the tip–sample law ("linear", "hertz", "dmt", "impact", or the system's own).
     fn law_name(&self) -> &'static str;
     /// Whether the region of a state depends on its history as well (a hysteretic law: JKR's
-    /// neck, [`crate::contact::ContactLaw::release_distance`]), so that [`HybridSystem::mode_at`]
+    /// neck, `crate::contact::ContactLaw::release_distance`), so that [`HybridSystem::mode_at`]
     /// decides a start in the band by a rule and a periodic orbit must be checked to end in the
     /// region it starts in ([`crate::analysis::shooting`]). `false` (the default) for a system
     /// whose region follows from the state.
@@ -113,7 +113,7 @@ pub trait TipSampleSystem: HybridSystem {
     /// The slowest decay rate of free motion, min |Re λ| over the damped eigenvalues λ of the
     /// free region (eqs. 20–21 for the cantilever), per unit τ: what the derived transient caps
     /// of the steady-state searches scale with
-    /// ([`crate::analysis::steady::decay_periods`]). `None` (the default) for a system
+    /// (`crate::analysis::steady::decay_periods`). `None` (the default) for a system
     /// without one; the caps then take their floors.
     fn free_decay_rate(&self) -> Option<f64> {
         None
@@ -136,7 +136,7 @@ pub trait TipSampleSystem: HybridSystem {
 /// # Errors
 /// [`SimError::NotCantilever`] naming `analysis` for a system that is not a
 /// [`CantileverModel`].
-pub fn require_cantilever<'a>(
+pub(crate) fn require_cantilever<'a>(
     system: &'a dyn TipSampleSystem,
     analysis: &'static str,
 ) -> Result<&'a CantileverModel, SimError> {

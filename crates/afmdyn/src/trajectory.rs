@@ -79,7 +79,7 @@ impl EnergyBalance {
     }
 
     /// (e_end − e_start) − (base_work − beam_dissipation − contact_dissipation).
-    pub fn residual(&self) -> f64 {
+    pub(crate) fn residual(&self) -> f64 {
         (self.e_end - self.e_start)
             - (self.base_work - self.beam_dissipation - self.contact_dissipation)
     }
@@ -88,7 +88,7 @@ impl EnergyBalance {
 /// Largest per-period residual of an energy balance ([`EnergyBalance::residual`]):
 /// (absolute, relative to the period's largest term). The relative residual is +∞ for a nonzero
 /// (or NaN) residual of a period whose terms are all 0.
-pub fn energy_residual(energy: &[EnergyBalance]) -> (f64, f64) {
+pub(crate) fn energy_residual(energy: &[EnergyBalance]) -> (f64, f64) {
     let (mut abs, mut rel) = (0.0f64, 0.0f64);
     for e in energy {
         let r = e.residual().abs();

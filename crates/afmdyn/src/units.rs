@@ -20,7 +20,7 @@ pub struct Material {
 }
 
 /// The paper's silicon tip (§4, from its ref. 44): E₁ = 130 GPa, ν₁ = 0.27.
-pub const SILICON_TIP: Material = Material {
+pub(crate) const SILICON_TIP: Material = Material {
     youngs_modulus: 130e9,
     poisson_ratio: 0.27,
 };
@@ -72,7 +72,7 @@ pub(crate) const SAMPLE_MATERIALS: &[(&str, Material)] = &[
 ///
 /// # Errors
 /// [`UnitsError::Choice`] listing the known names.
-pub fn material(name: &str) -> Result<Material, UnitsError> {
+pub(crate) fn material(name: &str) -> Result<Material, UnitsError> {
     preset(SAMPLE_MATERIALS, name, "sample", "material")
 }
 
@@ -100,7 +100,12 @@ pub(crate) fn preset<T: Copy>(
 
 /// Hertz contact stiffness K₁ = 2E*√(RΔ) (paper §4), E* of tip and sample
 /// (`crate::contact::reduced_modulus`). N/m.
-pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
+pub(crate) fn hertz_stiffness(
+    tip: Material,
+    sample: Material,
+    radius: f64,
+    indentation: f64,
+) -> f64 {
     let (t, s) = (tip, sample);
     let e_star = crate::contact::reduced_modulus(
         t.youngs_modulus,
@@ -174,7 +179,7 @@ impl Cantilever {
         }
     }
     /// First natural frequency of the bare cantilever f₁ = β₁² √(EI/(mL⁴)) / 2π (Hz).
-    pub fn first_frequency_hz(&self) -> f64 {
+    pub(crate) fn first_frequency_hz(&self) -> f64 {
         crate::beam::beta_root(1).powi(2) / self.time_scale() / std::f64::consts::TAU
     }
 }
@@ -336,7 +341,7 @@ impl PhysicalModel {
     }
 
     /// Time and length scales.
-    pub fn scales(&self) -> Scales {
+    pub(crate) fn scales(&self) -> Scales {
         let bare = self.cantilever.first_frequency_hz();
         // with the tip mass: the first eigenvalue of the Galerkin system (eq. 11)
         let with_tip = self
@@ -359,7 +364,7 @@ impl PhysicalModel {
 
 /// Contact stiffness given directly (N/m) or by the Hertz model.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ContactStiffness {
+pub(crate) enum ContactStiffness {
     /// K₁ in N/m.
     Direct(f64),
     /// K₁ = 2E*√(RΔ).
@@ -380,7 +385,7 @@ pub enum ContactStiffness {
 ///
 /// # Errors
 /// [`UnitsError`] for Q₁ ≤ 0 or an invalid model.
-pub fn beam_damping_from_q(model: &PhysicalModel, q1: f64) -> Result<f64, UnitsError> {
+pub(crate) fn beam_damping_from_q(model: &PhysicalModel, q1: f64) -> Result<f64, UnitsError> {
     positive("quality_factor", q1, "1")?;
     let mut undamped = *model;
     undamped.beam_damping = 0.0;
@@ -397,7 +402,7 @@ pub fn beam_damping_from_q(model: &PhysicalModel, q1: f64) -> Result<f64, UnitsE
 ///
 /// # Errors
 /// [`UnitsError`] for a non-positive radius/indentation/modulus or a Poisson ratio out of range.
-pub fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
+pub(crate) fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
     match k {
         ContactStiffness::Direct(k1) => non_negative("contact_stiffness", k1, "N/m"),
         ContactStiffness::Hertz {
@@ -489,7 +494,7 @@ pub struct PhysicalFile {
 }
 
 /// The `[hertz]` table of a [`PhysicalFile`]: K₁ as the Hertz contact's tangent stiffness at
-/// an indentation ([`ContactStiffness::Hertz`]).
+/// an indentation (`ContactStiffness::Hertz`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HertzFile {
@@ -497,11 +502,11 @@ pub struct HertzFile {
     pub tip_radius: f64,
     /// Indentation δ (m) at which K₁ is taken.
     pub indentation: f64,
-    /// Tip Young's modulus (Pa), default silicon ([`SILICON_TIP`]).
+    /// Tip Young's modulus (Pa), default silicon (`SILICON_TIP`).
     pub tip_youngs_modulus: Option<f64>,
     /// Tip Poisson ratio, default silicon.
     pub tip_poisson_ratio: Option<f64>,
-    /// A sample material by name ([`material`]); exclusive with the two moduli below.
+    /// A sample material by name (`material`); exclusive with the two moduli below.
     pub sample: Option<String>,
     /// Sample Young's modulus (Pa).
     pub sample_youngs_modulus: Option<f64>,
@@ -511,11 +516,11 @@ pub struct HertzFile {
 
 impl PhysicalFile {
     /// The physical model of the file: K₁ from `contact_stiffness` or `[hertz]`, C from
-    /// `beam_damping` or Q₁ ([`beam_damping_from_q`]).
+    /// `beam_damping` or Q₁ (`beam_damping_from_q`).
     ///
     /// # Errors
     /// [`UnitsError::Choice`] when both or neither of an exclusive pair are given; the range
-    /// errors of [`contact_stiffness`], [`material`] and [`beam_damping_from_q`].
+    /// errors of `contact_stiffness`, `material` and `beam_damping_from_q`.
     pub fn resolve(&self) -> Result<PhysicalModel, UnitsError> {
         let choice = |m: &str| UnitsError::Choice(m.into());
         let k1 = match (self.contact_stiffness, &self.hertz) {

@@ -8,7 +8,7 @@
 //!
 //! Units are the model's: τ (eq. 5) and lengths in g₀.
 //!
-//! **Lock-in** ([`LockIn`]). Over drive period k the deflection W(1,τ) is sampled at the ends of
+//! **Lock-in** (`LockIn`). Over drive period k the deflection W(1,τ) is sampled at the ends of
 //! M equal parts (θ_j = Ωτ_j + ψ, ψ the drive's phase) and demodulated by the rectangle rule,
 //! X_k = (2/M) Σ_j W_j sin θ_j = A cos φ, Y_k = −(2/M) Σ_j W_j cos θ_j = A sin φ for
 //! W = ⟨W⟩ + A sin(θ − φ): exact for a periodic motion but for the harmonics M ± 1, 2M ± 1, …
@@ -20,14 +20,14 @@
 //! over the period T: X̄_k = X̄_{k−1} + β (X_k − X̄_{k−1}), β = 1 − e^{−T/τ_L} (β = 1 for
 //! τ_L = 0: the period's own boxcar average); A = |(X̄, Ȳ)|, φ = arg(X̄ + iȲ).
 //!
-//! **PI controller** ([`PiController`]). With the error e_k = A_sp − A_k (positive when the tip
+//! **PI controller** (`PiController`). With the error e_k = A_sp − A_k (positive when the tip
 //! presses too hard and the amplitude drops) the piezo's rest distance for the next period is
 //! z_{k+1} = z_origin + K_P e_k + K_I T Σ_{j≤k} e_j (position form; K_P dimensionless, K_I per
 //! unit time), held within the output range given; a period at a limit counts as saturated and
 //! does not integrate an error that drives the output further out (conditional integration
 //! against wind-up).
 //!
-//! **Default gains** ([`FeedbackGains::for_lever`]). The amplitude answers a step of z within
+//! **Default gains** (`FeedbackGains::for_lever`). The amplitude answers a step of z within
 //! τ_c = 2Q/ω₀ (the lever's amplitude decay time) and, in both regimes, by about the step
 //! (dA/dz_c ≈ 1 on an approach curve), so with the lock-in's delay the loop is an integrator
 //! over a first-order lag τ_c + τ_L: K_I = 1/(4(τ_c + τ_L)) damps it critically
@@ -49,7 +49,7 @@ pub(crate) const LOCK_IN_SAMPLES: usize = 32;
 
 /// The feedback's gains and the lock-in's time constant (model units: τ, g₀).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FeedbackGains {
+pub(crate) struct FeedbackGains {
     /// K_P: rest-distance change per unit amplitude error (dimensionless), ≥ 0.
     pub proportional: f64,
     /// K_I: rest-distance rate per unit amplitude error (per unit τ), > 0.
@@ -61,7 +61,7 @@ pub struct FeedbackGains {
 impl FeedbackGains {
     /// The defaults of a lever of quality factor `q` and first free resonance `omega0` (rad
     /// per unit τ) (module docs): τ_L = τ_c/4, K_P = 0, K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀.
-    pub fn for_lever(q: f64, omega0: f64) -> Self {
+    pub(crate) fn for_lever(q: f64, omega0: f64) -> Self {
         let tau_c = 2.0 * q / omega0;
         let time_constant = tau_c / 4.0;
         FeedbackGains {
@@ -74,7 +74,7 @@ impl FeedbackGains {
 
 /// The lock-in amplifier (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LockIn {
+pub(crate) struct LockIn {
     /// β = 1 − e^{−T/τ_L}.
     beta: f64,
     /// X̄, Ȳ.
@@ -85,7 +85,7 @@ pub struct LockIn {
 impl LockIn {
     /// A lock-in of time constant `time_constant` (τ_L ≥ 0) updated once per `period`, its
     /// output preloaded with (`amplitude`, `phase`).
-    pub fn new(time_constant: f64, period: f64, amplitude: f64, phase: f64) -> Self {
+    pub(crate) fn new(time_constant: f64, period: f64, amplitude: f64, phase: f64) -> Self {
         let beta = if time_constant > 0.0 {
             -(-period / time_constant).exp_m1()
         } else {
@@ -99,18 +99,18 @@ impl LockIn {
     }
 
     /// Feed one period's demodulated first harmonic (A_k, φ_k).
-    pub fn update(&mut self, amplitude: f64, phase: f64) {
+    pub(crate) fn update(&mut self, amplitude: f64, phase: f64) {
         self.x += self.beta * (amplitude * phase.cos() - self.x);
         self.y += self.beta * (amplitude * phase.sin() - self.y);
     }
 
     /// The output amplitude A = |(X̄, Ȳ)|.
-    pub fn amplitude(&self) -> f64 {
+    pub(crate) fn amplitude(&self) -> f64 {
         self.x.hypot(self.y)
     }
 
     /// The output phase lag φ = arg(X̄ + iȲ), in (−π/2, 3π/2].
-    pub fn phase(&self) -> f64 {
+    pub(crate) fn phase(&self) -> f64 {
         wrap_phase(self.y.atan2(self.x))
     }
 }
@@ -127,7 +127,7 @@ impl LockIn {
 ///
 /// # Errors
 /// As the integrator.
-pub fn demodulate_period(
+pub(crate) fn demodulate_period(
     integ: &mut dyn Integrator,
     model: &CantileverModel,
     samples: usize,
@@ -158,7 +158,7 @@ pub fn demodulate_period(
     Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
 }
 
-/// [`demodulate_period`] with the integrator advanced to each sample (its steps cut there):
+/// `demodulate_period` with the integrator advanced to each sample (its steps cut there):
 /// the reference of the dense sampling.
 ///
 /// # Errors
@@ -186,7 +186,7 @@ pub fn demodulate_period_stepped(
 
 /// The PI controller (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PiController {
+pub(crate) struct PiController {
     proportional: f64,
     /// K_I T.
     integral_step: f64,
@@ -197,7 +197,7 @@ pub struct PiController {
 
 impl PiController {
     /// A controller of `gains` updated once per `period`, its output `origin` at zero error.
-    pub fn new(gains: &FeedbackGains, period: f64, origin: f64) -> Self {
+    pub(crate) fn new(gains: &FeedbackGains, period: f64, origin: f64) -> Self {
         PiController {
             proportional: gains.proportional,
             integral_step: gains.integral * period,
@@ -209,7 +209,7 @@ impl PiController {
     /// The output after the error `e`, held within `range` = (lowest, highest): the output and
     /// whether it saturated. An error that drives a saturated output further out is not
     /// integrated (conditional integration); one that drives it back is.
-    pub fn output(&mut self, e: f64, range: (f64, f64)) -> (f64, bool) {
+    pub(crate) fn output(&mut self, e: f64, range: (f64, f64)) -> (f64, bool) {
         let z = self.origin + self.proportional * e + self.integral_step * (self.sum + e);
         let (low, high) = (z < range.0, z > range.1);
         if !((low && e < 0.0) || (high && e > 0.0)) {
@@ -233,7 +233,7 @@ pub struct ScanPixel {
     pub tracking_error: f64,
     /// The material under the tip at the pixel's last period.
     pub material: usize,
-    /// Energy dissipated over the last period (F̃·g₀; [`observe`]).
+    /// Energy dissipated over the last period (F̃·g₀; `observe`).
     pub energy_dissipated: f64,
     /// Virial over the last period (F̃·g₀).
     pub virial: f64,
@@ -250,7 +250,7 @@ pub struct ScanPixel {
     pub lost_contact: bool,
     /// Periods at the controller's output limit.
     pub saturated: usize,
-    /// The per-mode energy balance of the last period ([`observe`]'s
+    /// The per-mode energy balance of the last period (`observe`'s
     /// [`crate::analysis::observables::ModeBalance`]): the largest |residual| relative to the
     /// drive's work on its mode — the balance ΔE_j = drive − damping − sample − coupling holds
     /// over any window, settled or not.

@@ -14,7 +14,7 @@ use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 
 /// The default z_c range of an approach (units of g₀): from 1.2 A₀ above the contact
-/// threshold, A₀ the free amplitude of `base` ([`free_response`]; under a multifrequency drive
+/// threshold, A₀ the free amplitude of `base` (`free_response`; under a multifrequency drive
 /// the sum of the components' free amplitudes), where the sample is out of reach, down to
 /// 0.1 A₀ above it — deep in the repulsive regime of a stiff sample — or, on a soft sample,
 /// to 0.4 A₀ − δ_k (`soft_indentation`): a rigid sample holds the amplitude at A/A₀ = 0.5
@@ -101,7 +101,7 @@ pub(crate) fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
 /// (units of g₀) with the given spacing of z_c, then the retract; the swept parameter is α5.
 ///
 /// # Errors
-/// As [`grid`]: non-finite or equal ends, a bad step, more than 100 000 points.
+/// As `grid`: non-finite or equal ends, a bad step, more than 100 000 points.
 pub fn approach_spec(
     base: Params,
     z_from: f64,
@@ -118,7 +118,7 @@ pub fn approach_spec(
 }
 
 /// The rest distance z_c of the gap value α5 = `alpha5` under `base`'s contact law.
-pub fn rest_distance(base: &Params, alpha5: f64) -> f64 {
+pub(crate) fn rest_distance(base: &Params, alpha5: f64) -> f64 {
     base.with(SweepParam::Alpha5, alpha5).rest_distance()
 }
 

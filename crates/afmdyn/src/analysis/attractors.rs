@@ -117,7 +117,7 @@ pub struct AttractorReport {
     /// Ends that had not settled within the transient cap ([`Attractor::unsettled`]), grouped
     /// as the attractors are; not attractors, and not counted in the basin fractions.
     pub unsettled: Vec<Attractor>,
-    /// The transient cap of the runs, in drive periods ([`SteadyOptions::cap`]).
+    /// The transient cap of the runs, in drive periods (`SteadyOptions::cap`).
     pub transient_cap: usize,
     /// Starts that failed (error messages).
     pub failures: Vec<String>,

@@ -23,7 +23,7 @@ use std::collections::HashMap;
 
 /// Basin entropy S_b, boundary basin entropy S_bb and the number of boxes of each.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BasinEntropy {
+pub(crate) struct BasinEntropy {
     /// S_b: the mean Gibbs entropy of all boxes (nats).
     pub basin_entropy: f64,
     /// S_bb: the mean over the boxes with more than one label (nats; 0 when there are none).
@@ -37,7 +37,7 @@ pub struct BasinEntropy {
 /// S_b and S_bb of the `labels` (row-major, `nx` per row) in boxes of `n` × `n` cells (Daza et
 /// al. use n = 5); cells of incomplete boxes at the right and top edges are left out. `None`
 /// when no whole box fits or the labels are not `nx` × rows.
-pub fn basin_entropy(labels: &[i64], nx: usize, n: usize) -> Option<BasinEntropy> {
+pub(crate) fn basin_entropy(labels: &[i64], nx: usize, n: usize) -> Option<BasinEntropy> {
     if nx == 0 || n == 0 || !labels.len().is_multiple_of(nx) {
         return None;
     }

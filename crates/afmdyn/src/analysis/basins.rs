@@ -69,7 +69,7 @@ pub const DEFAULT_DISCOVER_AFTER: usize = 200;
 /// Consecutive returns in coarse cells whose four corners share one label that decide a start
 /// of a later pass (one return decides when the 3 × 3 coarse cells around it share the label).
 pub(crate) const GRID_HITS: usize = 2;
-/// Default stride of the first pass's coarse grid: 0, automatic ([`BasinSpec::first_stride`]).
+/// Default stride of the first pass's coarse grid: 0, automatic (`BasinSpec::first_stride`).
 pub const DEFAULT_STRIDE: usize = 0;
 /// Fewest nodes per axis of the first pass's coarse grid chosen automatically. (On the impact
 /// oscillator N = 1, r = 0.8, Ω = 2 at 100 × 100, a first grid of 13 × 13 (stride 8) held no
@@ -177,7 +177,7 @@ pub struct BasinSpec {
     /// Returns tested before the steady-state search takes over.
     pub discover_after: usize,
     /// Stride of the first pass's coarse grid (every `stride`-th row and column, halved pass by
-    /// pass); 1: one pass; 0: automatic ([`BasinSpec::first_stride`]). Used where the map's
+    /// pass); 1: one pass; 0: automatic (`BasinSpec::first_stride`). Used where the map's
     /// plane is the whole section (N = 1, a position and a velocity).
     pub stride: usize,
     /// The steady-state search (its `max_periods` caps the whole start).
@@ -269,7 +269,7 @@ impl BasinSpec {
 
     /// The stride of the first pass: `stride`, or when 0 the largest power of two that leaves
     /// the coarse grid at least `MIN_COARSE_NODES` nodes per axis (1 for a map of fewer).
-    pub fn first_stride(&self) -> usize {
+    pub(crate) fn first_stride(&self) -> usize {
         if self.stride > 0 {
             return self.stride;
         }
@@ -389,7 +389,7 @@ impl BasinMap {
 
 /// One finished row of a pass: its cells and the attractors found there beyond those the pass
 /// began with (a cell's label indexes the pass's initial ones, then these): what a run shows
-/// row by row ([`run_passes`]) and what a stored run's map is assembled from ([`basin_map`]).
+/// row by row (`run_passes`) and what a stored run's map is assembled from (`basin_map`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BasinRow {
     /// The pass (0 the coarsest; one pass where the plane is not the whole section).
@@ -504,7 +504,7 @@ pub(crate) fn run_pass_row(
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
-pub fn run_passes(
+pub(crate) fn run_passes(
     spec: &BasinSpec,
     model: &CantileverModel,
     stored: &[BasinRow],
@@ -548,7 +548,7 @@ pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
 /// # Errors
 /// [`SimError`] for invalid parameters; [`SimError::Cancelled`] when a cell is missing (a run
 /// that was cut short).
-pub fn basin_map(spec: &BasinSpec, rows: Vec<BasinRow>) -> Result<BasinMap, SimError> {
+pub(crate) fn basin_map(spec: &BasinSpec, rows: Vec<BasinRow>) -> Result<BasinMap, SimError> {
     let model = CantileverModel::new(&spec.params)?;
     basin_map_of(spec, &model, merge_passes(spec, rows.into_iter()))
 }

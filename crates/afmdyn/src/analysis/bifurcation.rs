@@ -29,7 +29,7 @@ pub(crate) const RANDOM_AMPLITUDE: f64 = 0.6;
 pub const MAX_SWEEP_POINTS: usize = 1_000_000;
 
 /// A reproducible random initial state for sample `index` of the stream `seed`.
-pub fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f64> {
+pub(crate) fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let n = model.modes();
     let shapes = model.galerkin().shapes();
@@ -48,7 +48,12 @@ pub fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f
 /// the stream is keyed by the sweep's seed, the value's bits and the start number, so the same
 /// parameter point gets the same starts in any sweep that contains it, whatever its range,
 /// order of execution or thread count.
-pub fn start_state(model: &CantileverModel, seed: u64, value: f64, start: u32) -> DVector<f64> {
+pub(crate) fn start_state(
+    model: &CantileverModel,
+    seed: u64,
+    value: f64,
+    start: u32,
+) -> DVector<f64> {
     random_state(model, seed, mix64(value.to_bits()) ^ u64::from(start))
 }
 
@@ -217,7 +222,7 @@ fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<Steady
 
 /// One task of a planned sweep ([`SweepPlan`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum SweepTask {
+pub(crate) enum SweepTask {
     /// Stage 0: the coarse continuation of a branch over the first value of each of its
     /// chunks, whose end states seed the chunks.
     Coarse(Branch),
@@ -232,7 +237,7 @@ pub enum SweepTask {
 /// coarse pass's end state at the chunk's first value; rest for chunk 0 and where the coarse
 /// point failed and no earlier one succeeded).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Seeds {
+pub(crate) struct Seeds {
     forward: Vec<DVector<f64>>,
     backward: Vec<DVector<f64>>,
 }
@@ -270,7 +275,7 @@ impl Seeds {
 /// plus the random starts), so the sequential coarse pass is √n points against the 2n of the
 /// chains: an Amdahl bound of 2n/(√n + 2n/T) on T threads (≈ 28× on 64 threads at n = 400).
 #[derive(Debug, Clone, Copy)]
-pub struct SweepPlan<'a> {
+pub(crate) struct SweepPlan<'a> {
     spec: &'a SweepSpec,
     chunk: usize,
     chunks: usize,
@@ -278,7 +283,7 @@ pub struct SweepPlan<'a> {
 
 impl<'a> SweepPlan<'a> {
     /// The plan of `spec`.
-    pub fn new(spec: &'a SweepSpec) -> SweepPlan<'a> {
+    pub(crate) fn new(spec: &'a SweepSpec) -> SweepPlan<'a> {
         let n = spec.values.len().max(1);
         let chunks = ((n as f64).sqrt().ceil() as usize).clamp(1, n);
         let chunk = n.div_ceil(chunks);
@@ -290,7 +295,7 @@ impl<'a> SweepPlan<'a> {
     }
 
     /// Chunks per continuation branch (0 without continuation).
-    pub fn chunks(&self) -> usize {
+    pub(crate) fn chunks(&self) -> usize {
         if self.spec.continuation && !self.spec.values.is_empty() {
             self.chunks
         } else {
@@ -300,7 +305,7 @@ impl<'a> SweepPlan<'a> {
 
     /// The tasks of `stage` (0: the coarse passes; 1: the chain segments, then the random
     /// starts value by value); no tasks beyond stage 1.
-    pub fn tasks(&self, stage: usize) -> Vec<SweepTask> {
+    pub(crate) fn tasks(&self, stage: usize) -> Vec<SweepTask> {
         let branches = [Branch::Forward, Branch::Backward];
         match stage {
             0 if self.chunks() > 1 => branches.map(SweepTask::Coarse).to_vec(),
@@ -318,7 +323,7 @@ impl<'a> SweepPlan<'a> {
 
     /// The value indices of `branch` in its order of continuation (increasing forward,
     /// decreasing backward), chunk `k` of them.
-    pub fn chunk_indices(&self, branch: Branch, k: usize) -> Vec<usize> {
+    pub(crate) fn chunk_indices(&self, branch: Branch, k: usize) -> Vec<usize> {
         let n = self.spec.values.len();
         let lo = (k * self.chunk).min(n);
         let hi = ((k + 1) * self.chunk).min(n);
@@ -382,7 +387,7 @@ impl<'a> SweepPlan<'a> {
     /// Run one stage-1 task: each of its points not in `resume` goes to `sink` as soon as it
     /// is finished. A chain segment goes on from the stored state of its done points. A
     /// coarse task does nothing here (see `SweepPlan::coarse`).
-    pub fn run_task(
+    pub(crate) fn run_task(
         &self,
         task: SweepTask,
         seeds: &Seeds,
@@ -458,7 +463,7 @@ pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) +
 ///
 /// The local executor of a [`SweepPlan`]: the coarse passes, then every stage-1 task on the
 /// current rayon pool (one task per work item, no shared lock: points go straight to `sink`).
-pub fn run_sweep_cancellable(
+pub(crate) fn run_sweep_cancellable(
     spec: &SweepSpec,
     resume: &Resume,
     sink: &(dyn Fn(SweepPoint) + Sync),

@@ -180,7 +180,7 @@ pub struct FmReference {
     pub phase: f64,
     /// α2 that holds the first-harmonic amplitude at A at ω_K without a sample.
     pub excitation: f64,
-    /// k̃_K: the tracked mode's stiffness at the tip (F̃/g₀; [`crate::eigen::mode_at_tip`], 1
+    /// k̃_K: the tracked mode's stiffness at the tip (F̃/g₀; `crate::eigen::mode_at_tip`, 1
     /// for the point mass): the k of Giessibl's and Sader–Jarvis's formulas for this mode.
     pub stiffness: f64,
 }

@@ -6,7 +6,7 @@
 //!
 //! Each cycle k runs one drive period at (Ω_k, α2_k) from the state the previous one ended in
 //! (the drive's phase is continuous: every period starts at phase 0), demodulates the tip's
-//! first harmonic over it exactly ([`super::observables::observe`]), and updates
+//! first harmonic over it exactly (`super::observables::observe`), and updates
 //!
 //! Ω_{k+1} = Ω_k − g_φ (ω_K / 2Q_K) (φ₁ − φ_set),  α2_{k+1} = α2_k (1 − g_A (A₁/A − 1)),
 //!

@@ -5,7 +5,7 @@
 //!
 //! 1. at every value of the parameter, in order, an attractor census ([`super::attractors`])
 //!    runs `samples` random starts — keyed by (seed, the value's bits, k) as a sweep's random
-//!    starts are ([`start_state`]), so a value gets the same starts in any range containing it —
+//!    starts are (`start_state`), so a value gets the same starts in any range containing it —
 //!    *and* one start from the last section point of every attractor of the previous value (a
 //!    *seed*; it finds attractors whose basin the random starts miss, and follows each through
 //!    the step);
@@ -38,7 +38,7 @@ pub const MAX_CONTINUATION_VALUES: usize = 10_000;
 /// Largest number of runs (values × samples) of a global continuation.
 pub(crate) const MAX_CONTINUATION_RUNS: usize = 2_000_000;
 /// Default relative set distance within which two attractors at consecutive values are one.
-pub const DEFAULT_MATCH_TOL: f64 = 0.1;
+pub(crate) const DEFAULT_MATCH_TOL: f64 = 0.1;
 
 /// A global continuation.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,7 +118,7 @@ pub struct ContinuationStep {
 
 /// The symmetric Hausdorff distance between two sets of Poincaré points, each distance
 /// relative: max( max_x min_y |x − y|/(1 + |y|), max_y min_x |y − x|/(1 + |x|) ).
-pub fn set_distance(a: &SteadyState, b: &SteadyState) -> f64 {
+pub(crate) fn set_distance(a: &SteadyState, b: &SteadyState) -> f64 {
     let one_way = |p: &SteadyState, q: &SteadyState| {
         p.poincare
             .iter()

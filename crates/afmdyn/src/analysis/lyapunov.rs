@@ -24,7 +24,7 @@ use serde::Serialize;
 
 /// Options of the Lyapunov computation.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LyapunovOptions {
+pub(crate) struct LyapunovOptions {
     /// Drive periods discarded first.
     pub transient_periods: usize,
     /// Drive periods averaged.
@@ -51,7 +51,7 @@ impl LyapunovOptions {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `blocks` unless periods ≥ blocks ≥ 2.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if self.blocks < 2 || self.periods < self.blocks {
             return Err(SimError::out_of_range(
                 "blocks",
@@ -77,7 +77,7 @@ pub enum Verdict {
     Undecided,
 }
 
-/// Result of [`lyapunov_spectrum`].
+/// Result of `lyapunov_spectrum`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LyapunovSpectrum {
     /// Exponents per unit τ, in decreasing order (2N of them).
@@ -131,7 +131,7 @@ pub(crate) fn largest_exponent(
 ///
 /// # Errors
 /// [`SimError`] for invalid options or a failing run.
-pub fn lyapunov_spectrum(
+pub(crate) fn lyapunov_spectrum(
     model: &CantileverModel,
     z0: &DVector<f64>,
     opts: &LyapunovOptions,
@@ -148,7 +148,7 @@ pub fn lyapunov_spectrum(
 ///
 /// # Errors
 /// As [`lyapunov_spectrum`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn lyapunov_spectrum_with(
+pub(crate) fn lyapunov_spectrum_with(
     integ: &mut dyn Integrator,
     opts: &LyapunovOptions,
     progress: &Progress,
@@ -289,7 +289,7 @@ fn run_warnings(
 /// D_c(n) = M_c(n) − ⟨φ⟩² (1 − cos nc)/(1 − cos c) and M_c the mean square displacement of
 /// p_c(n) = Σ φ_j cos jc, q_c(n) = Σ φ_j sin jc. Returns NaN for fewer than 100 points and 0
 /// for a series constant to 1e-9 (a period-1 orbit seen on its section).
-pub fn zero_one_test(phi: &[f64], seed: u64) -> f64 {
+pub(crate) fn zero_one_test(phi: &[f64], seed: u64) -> f64 {
     let len = phi.len();
     if len < 100 {
         return f64::NAN;

@@ -12,7 +12,7 @@
 pub mod am_loop;
 pub mod approach;
 pub mod attractors;
-pub mod basin_entropy;
+pub(crate) mod basin_entropy;
 pub mod basins;
 pub mod bifurcation;
 pub mod chart;

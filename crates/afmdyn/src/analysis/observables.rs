@@ -29,7 +29,7 @@
 //! unit of α4 V_T; k g₀ for the point-mass model), energies F̃·g₀.
 //!
 //! # Conventions
-//! * **Harmonics.** W(1,τ) ≈ ⟨W⟩ + Σₙ Aₙ sin(n(Ωτ + ψ) − φₙ), ψ = [`Params::drive_phase`]
+//! * **Harmonics.** W(1,τ) ≈ ⟨W⟩ + Σₙ Aₙ sin(n(Ωτ + ψ) − φₙ), ψ = `Params::drive_phase`
 //!   (drive ∝ sin(Ωτ + ψ)), so φ = φ₁ is the lag of the deflection behind the drive: 90° at the
 //!   free resonance, > 90° in the attractive and < 90° in the repulsive regime (García & San
 //!   Paulo, *Phys. Rev. B* 60 (1999) 4961). Phases are reported in (−π/2, 3π/2], so lags near 0
@@ -93,7 +93,7 @@ use std::num::NonZeroUsize;
 mod closed;
 mod window;
 use closed::EquivalentMode;
-pub use closed::{closed_forms, free_response};
+pub(crate) use closed::{closed_forms, free_response};
 use window::{observe_window, Weighting};
 
 /// Largest accepted [`ObservableOptions::periods`].
@@ -160,7 +160,7 @@ pub struct ModeBalance {
 
 /// The free linear response of the tip at the drive frequency: W = A₀ sin(Ωτ + ψ − φ₀).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FreeResponse {
+pub(crate) struct FreeResponse {
     /// Free amplitude A₀ = |φᵀ(K − Ω²M + iΩC)⁻¹(F_s + iF_c)| (units of g₀).
     pub amplitude: f64,
     /// Lag φ₀ behind the drive, rad, in (−π/2, 3π/2].
@@ -172,7 +172,7 @@ pub struct FreeResponse {
 /// ω = ω₀; elsewhere an approximation, reported to show how far it is off.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ClosedForms {
-    /// A₀: free tip amplitude at Ω from the linear free response ([`free_response`]), g₀.
+    /// A₀: free tip amplitude at Ω from the linear free response (`free_response`), g₀.
     pub free_amplitude: f64,
     /// Lag of the free response behind the drive, rad.
     pub free_phase: f64,
@@ -309,7 +309,7 @@ pub(crate) fn wrap_phase(p: f64) -> f64 {
 /// # Errors
 /// [`SimError::OutOfRange`] for `periods` outside 1..=`MAX_PERIODS` or `harmonics` outside
 /// 1..=`MAX_HARMONICS`, or from [`free_response`]; [`SimError`] from the integrator.
-pub fn observe(
+pub(crate) fn observe(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
 ) -> Result<Observables, SimError> {
@@ -333,7 +333,7 @@ pub fn observe(
 ///
 /// # Errors
 /// As [`observe`].
-pub fn observe_tapered(
+pub(crate) fn observe_tapered(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
 ) -> Result<Observables, SimError> {
@@ -368,7 +368,7 @@ pub(crate) fn observe_weighted(
 ///
 /// # Errors
 /// As [`build`] and [`observe`].
-pub fn observe_from(
+pub(crate) fn observe_from(
     model: &CantileverModel,
     integ: IntegratorOptions,
     tau0: f64,
@@ -379,11 +379,11 @@ pub fn observe_from(
     observe(it.as_mut(), opts)
 }
 
-/// [`observe_from`] on a periodic orbit found by shooting ([`super::shooting`]): from its state
+/// `observe_from` on a periodic orbit found by shooting ([`super::shooting`]): from its state
 /// at τ = 0 over its n drive periods, harmonics up to `harmonics`.
 ///
 /// # Errors
-/// As [`observe_from`].
+/// As `observe_from`.
 pub fn observe_orbit(
     model: &CantileverModel,
     integ: IntegratorOptions,

@@ -39,7 +39,7 @@ mod setpoint;
 
 pub use filter::low_pass_periodic;
 pub(crate) use fit::MIN_FIT_POINTS;
-pub(crate) use fit::{fit_dmt, DmtFit, FIT_BAND};
+pub use fit::{fit_dmt, DmtFit, FIT_BAND};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,
     SETPOINT_TOL,
@@ -66,7 +66,7 @@ pub(crate) const MAX_CYCLE_SAMPLES: usize = 1_000_000;
 /// would misplace it by a sample's travel (the fit's δ^{3/2} is sensitive to d₀).
 pub(crate) const FIT_SAMPLES: usize = 20_000;
 
-/// Options of [`steady_tap`].
+/// Options of `steady_tap`.
 #[derive(Debug, Clone)]
 pub struct PeakForceOptions {
     /// Samples of the reported cycle, in `MIN_CYCLE_SAMPLES`..=`MAX_CYCLE_SAMPLES`.
@@ -176,7 +176,7 @@ pub struct EnergyBalance {
     pub residual: f64,
 }
 
-/// The steady tap of [`steady_tap`].
+/// The steady tap of `steady_tap`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SteadyTap {
     /// n: the orbit repeats after n modulation periods (2 for period-2 tapping).
@@ -213,7 +213,10 @@ pub struct SteadyTap {
 /// [`SimError::OutOfRange`] for bad options; [`SimError::NoConvergence`] when the transient
 /// does not settle to a periodic orbit within its cap (reported, not hidden); [`SimError`]
 /// from the integrator.
-pub fn steady_tap(model: &CantileverModel, opts: &PeakForceOptions) -> Result<SteadyTap, SimError> {
+pub(crate) fn steady_tap(
+    model: &CantileverModel,
+    opts: &PeakForceOptions,
+) -> Result<SteadyTap, SimError> {
     let z0 = DVector::zeros(model.params().state_dim());
     steady_tap_from(model, opts, &z0)
 }

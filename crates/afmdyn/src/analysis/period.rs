@@ -27,7 +27,11 @@ fn within(a: &[f64], b: &[f64], bound: f64) -> bool {
 ///
 /// Called on every return of a transient, where the first test (the last return against
 /// the one n earlier) fails for every n: its bound tol (1 + ‖P_k‖) is formed once.
-pub fn detect_period(history: &[DVector<f64>], tol: f64, max_period: usize) -> Option<usize> {
+pub(crate) fn detect_period(
+    history: &[DVector<f64>],
+    tol: f64,
+    max_period: usize,
+) -> Option<usize> {
     let len = history.len();
     let last = len.checked_sub(1)?;
     let newest = history[last].as_slice();
@@ -39,13 +43,13 @@ pub fn detect_period(history: &[DVector<f64>], tol: f64, max_period: usize) -> O
 }
 
 /// Factor by which the tolerance is widened when a detected period n is reduced to a divisor.
-pub const MERGE_FACTOR: f64 = 1e3;
+pub(crate) const MERGE_FACTOR: f64 = 1e3;
 
 /// The smallest divisor d of `n` such that the last `n` returns repeat with shift d within
 /// `tol`. A stable focus whose returns rotate by ≈ 2π/n per period matches its n-th iterate
 /// long before its consecutive iterates agree; reducing with a wider tolerance
 /// (`MERGE_FACTOR` × the detection tolerance) reports it as the fixed point it converges to.
-pub fn minimal_divisor(history: &[DVector<f64>], n: usize, tol: f64) -> usize {
+pub(crate) fn minimal_divisor(history: &[DVector<f64>], n: usize, tol: f64) -> usize {
     let last = history.len() - 1;
     (1..n)
         .filter(|&d| n.is_multiple_of(d) && history.len() > n + d)

@@ -35,7 +35,7 @@ impl Progress {
         }
     }
     /// Count `n` units done.
-    pub fn advance(&self, n: usize) {
+    pub(crate) fn advance(&self, n: usize) {
         self.done.fetch_add(n, Ordering::Relaxed);
     }
     /// Count one unit done.

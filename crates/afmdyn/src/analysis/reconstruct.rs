@@ -34,15 +34,15 @@
 //! Ω(t) + g(t)/√(t − d), g = (A^{1/2}/(8√π)) Ω − (A^{3/2}/√2) Ω′, the Ω part of the trapezoid
 //! beyond the first interval is a suffix sum (O(N)), and the g part Σ_i w_i g_i / √(d_i − d_j)
 //! depends on d_i − d_j only: on a uniform grid it is a correlation with the kernel 1/√(m h),
-//! taken by FFT ([`sader_jarvis`] on a grid that [`uniform_spacing`] accepts: O(N log N)). The
-//! FFT takes the kernel at m h for m > [`NEAR_FIELD`] only; the nearer terms, where a grid's
+//! taken by FFT ([`sader_jarvis`] on a grid that `uniform_spacing` accepts: O(N log N)). The
+//! FFT takes the kernel at m h for m > `NEAR_FIELD` only; the nearer terms, where a grid's
 //! round-off moves the kernel most, are summed directly with the grid's own distances, and the
 //! trapezoid weights and the first interval use the grid's own spacings: the result is the
 //! direct sum's, to round-off (on an exactly even grid) or to the grid's unevenness (≤
-//! [`UNIFORM_TOLERANCE`] of a spacing, divided by [`NEAR_FIELD`]) — tests/reconstruct.rs.
-//! The size is bounded before the run ([`ShiftCurve::method`]): at most [`MAX_UNIFORM_POINTS`]
+//! `UNIFORM_TOLERANCE` of a spacing, divided by `NEAR_FIELD`) — tests/reconstruct.rs.
+//! The size is bounded before the run (`ShiftCurve::method`): at most `MAX_UNIFORM_POINTS`
 //! points on a uniform grid (the FFT's buffers: three of 16 bytes × the next power of two ≥
-//! 2N, 200 MB at the limit), at most [`MAX_DIRECT_POINTS`] on another grid (the direct sum's
+//! 2N, 200 MB at the limit), at most `MAX_DIRECT_POINTS` on another grid (the direct sum's
 //! N²/2 pairs, 2·10⁸ at the limit: some 3 s on one core). Both check their
 //! [`Progress`]'s cancel flag between chunks of rows.
 //!
@@ -114,7 +114,7 @@ pub struct ExactRecord {
     pub sader_jarvis_residual: f64,
     /// The forward residual ρ of the result.
     pub forward_residual: f64,
-    /// ρ ≤ [`crate::analysis::reconstruct_exact::EXACT_TOLERANCE`] (else the iteration
+    /// ρ ≤ `crate::analysis::reconstruct_exact::EXACT_TOLERANCE` (else the iteration
     /// stalled or reached its cap).
     pub converged: bool,
 }
@@ -170,28 +170,28 @@ impl ShiftCurve {
 /// floating point (numpy's `linspace`, `arange`) is off by about 10⁻¹⁶ N d_max/(d_max − d_0)
 /// spacings, 2·10⁻¹⁰ at the [`MAX_UNIFORM_POINTS`] limit; a grid printed to fewer digits than
 /// its spacing needs is not.
-pub const UNIFORM_TOLERANCE: f64 = 1e-9;
+pub(crate) const UNIFORM_TOLERANCE: f64 = 1e-9;
 
 /// The most points of a uniform grid ([`UNIFORM_TOLERANCE`]): the FFT's three buffers of 16
 /// bytes × the next power of two ≥ 2N take 200 MB at 2·10⁶ points (and the documents of the
 /// front ends some 100 bytes a point).
-pub const MAX_UNIFORM_POINTS: usize = 2_000_000;
+pub(crate) const MAX_UNIFORM_POINTS: usize = 2_000_000;
 
 /// The most points of a grid that is not uniform: the direct sum's N²/2 pairs, 2·10⁸ at
 /// 20 000 points, take some 3 s on one core (measured: 0.66 s for 10⁴ points,
 /// scripts/perf-reconstruct.sh).
-pub const MAX_DIRECT_POINTS: usize = 20_000;
+pub(crate) const MAX_DIRECT_POINTS: usize = 20_000;
 
 /// The terms of the g part with i − j ≤ `NEAR_FIELD` are summed directly with the grid's own
 /// distances, the rest by FFT with the kernel at (i − j) h (module doc).
-pub const NEAR_FIELD: usize = 32;
+pub(crate) const NEAR_FIELD: usize = 32;
 
 /// Rows of the direct sum between two checks of the cancel flag.
 const CHUNK: usize = 256;
 
 /// How [`sader_jarvis`] sums a curve.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Method {
+pub(crate) enum Method {
     /// The g part by FFT on a uniform grid of spacing `h` (module doc).
     Fft {
         /// The spacing (d_max − d_0)/(N − 1).
@@ -202,7 +202,7 @@ pub enum Method {
 }
 
 /// The spacing of `d` (increasing, ≥ 2 values) when it is uniform to [`UNIFORM_TOLERANCE`].
-pub fn uniform_spacing(d: &[f64]) -> Option<f64> {
+pub(crate) fn uniform_spacing(d: &[f64]) -> Option<f64> {
     let n = d.len();
     if n < 2 {
         return None;
@@ -221,7 +221,7 @@ impl ShiftCurve {
     /// # Errors
     /// As [`ShiftCurve::validate`]; [`SimError::OutOfRange`] naming `distance` for more than
     /// [`MAX_UNIFORM_POINTS`] points on a uniform grid or [`MAX_DIRECT_POINTS`] on another.
-    pub fn method(&self) -> Result<Method, SimError> {
+    pub(crate) fn method(&self) -> Result<Method, SimError> {
         self.validate()?;
         let n = self.distance.len();
         match uniform_spacing(&self.distance) {
@@ -273,13 +273,13 @@ fn first_interval(omega: f64, slope: f64, step: f64, a: f64) -> f64 {
 }
 
 /// The force and potential of `curve` by the Sader–Jarvis inversion (module doc): by FFT on a
-/// uniform grid, else by the direct sum ([`ShiftCurve::method`]).
+/// uniform grid, else by the direct sum (`ShiftCurve::method`).
 ///
 /// It counts the curve's points in `progress` and checks its cancel flag between chunks of
 /// rows.
 ///
 /// # Errors
-/// As [`ShiftCurve::method`]; [`SimError::Cancelled`] once `progress` is cancelled.
+/// As `ShiftCurve::method`; [`SimError::Cancelled`] once `progress` is cancelled.
 pub fn sader_jarvis(curve: &ShiftCurve, progress: &Progress) -> Result<Reconstruction, SimError> {
     match curve.method()? {
         Method::Fft { h } => sader_jarvis_fft(curve, h, progress),
@@ -289,7 +289,7 @@ pub fn sader_jarvis(curve: &ShiftCurve, progress: &Progress) -> Result<Reconstru
 
 /// The Sader–Jarvis inversion by the direct O(N²) sum, term by term as the module doc writes
 /// it: the reference of the FFT, and the method on a grid that is not uniform. No size limit
-/// (the caller's: [`ShiftCurve::method`]).
+/// (the caller's: `ShiftCurve::method`).
 ///
 /// # Errors
 /// As [`ShiftCurve::validate`]; [`SimError::Cancelled`] once `progress` is cancelled.

@@ -35,9 +35,9 @@
 //!
 //! **Convergence.** The forward residual ρ_n = max_k |Δf_k − (G F_n)_k| / max_k |Δf_k| (all
 //! rows but the last) is computed after each step. The iteration stops when ρ ≤
-//! [`EXACT_TOLERANCE`] (the data's round-off: converged), when a step leaves more than
+//! `EXACT_TOLERANCE` (the data's round-off: converged), when a step leaves more than
 //! `STALL_RATIO` of it (stalled: the step is kept only if it lowered ρ), or after
-//! [`EXACT_MAX_ITERATIONS`] steps. [`ExactRecord`] reports the steps, ρ before and after and
+//! `EXACT_MAX_ITERATIONS` steps. [`ExactRecord`] reports the steps, ρ before and after and
 //! whether it converged. Measured on the van der Waals round trip (tests/reconstruct_exact.rs):
 //! ρ falls from ~10⁻² (Sader–Jarvis) to ~10⁻⁵ in 3 to 5 steps, the residual of each row
 //! below 10⁻⁸ of its own Δf away from the data's end; what is left sits in the rows within
@@ -62,14 +62,14 @@ use std::sync::Arc;
 
 /// The forward residual (relative to the largest |Δf|) at which the iteration has converged:
 /// the round-off of the data and of the forward relation's sums.
-pub const EXACT_TOLERANCE: f64 = 1e-12;
+pub(crate) const EXACT_TOLERANCE: f64 = 1e-12;
 
 /// A step that leaves more than this share of the forward residual has stalled: the
 /// iteration stops.
 pub(crate) const STALL_RATIO: f64 = 0.9;
 
 /// The most correction steps.
-pub const EXACT_MAX_ITERATIONS: usize = 50;
+pub(crate) const EXACT_MAX_ITERATIONS: usize = 50;
 
 /// On a uniform grid, a forward relation with at most this many weights beyond the diagonal
 /// is summed directly; with more, by FFT.

@@ -16,7 +16,7 @@ use crate::params::{Params, SweepParam, OMEGA_MAX, OMEGA_MIN};
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for k outside 1..=N; [`SimError::Params`] for invalid parameters.
-pub fn mode_band(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
+pub(crate) fn mode_band(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
     let (omega, q) = mode_resonance(params, k)?;
     let w = (6.0 / q).clamp(0.02, 0.5);
     Ok((
@@ -55,7 +55,7 @@ pub(crate) fn mode_resonance(params: &Params, k: usize) -> Result<(f64, f64), Si
 ///
 /// # Errors
 /// As [`grid`].
-pub fn resonance_spec(
+pub(crate) fn resonance_spec(
     base: Params,
     from: f64,
     to: f64,

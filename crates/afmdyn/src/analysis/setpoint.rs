@@ -2,8 +2,8 @@
 //! ratio A/A₀ equals the setpoint A_sp/A₀ that an instrument's feedback holds while it images.
 //! On every stable stretch of every continued branch (or, without branches, of the approach and
 //! retract sweeps) each crossing of the setpoint is first located by linear interpolation
-//! between the two curve points around it ([`setpoint_crossings`]). Between two periodic
-//! orbits, the crossing is then the exact orbit whose A/A₀ is the setpoint ([`operating_points`]:
+//! between the two curve points around it (`setpoint_crossings`). Between two periodic
+//! orbits, the crossing is then the exact orbit whose A/A₀ is the setpoint (`operating_points`:
 //! regula falsi with the Illinois modification on the swept value, each value's orbit found by
 //! shooting from the state interpolated between the bracket's orbits), and its observables —
 //! phase, peak force, indentation, minimum distance, dissipated energy: the quantities of a
@@ -73,7 +73,7 @@ fn crossings_of(points: &[Point], source: Source, ratio: f64, out: &mut Vec<Cros
 
 /// Every crossing of A/A₀ = `ratio` on the stable stretches of `curve`'s branches, or of its
 /// two sweeps when it has no branches.
-pub fn setpoint_crossings(curve: &SteppedCurve, ratio: f64) -> Vec<Crossing> {
+pub(crate) fn setpoint_crossings(curve: &SteppedCurve, ratio: f64) -> Vec<Crossing> {
     let ratio_of = |o: &super::observables::Observables| o.amplitude / o.closed_form.free_amplitude;
     let mut out = Vec::new();
     if curve.branches.is_empty() {
@@ -126,7 +126,7 @@ type Bracketed = (f64, DVector<f64>, f64);
 ///
 /// # Errors
 /// [`SimError`] from the model of a swept value (the curve's own values are valid).
-pub fn operating_points(
+pub(crate) fn operating_points(
     spec: &SteppedSpec,
     curve: &SteppedCurve,
     ratio: f64,

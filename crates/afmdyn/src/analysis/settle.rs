@@ -268,7 +268,12 @@ fn settled(found: Found, state: DVector<f64>, periods: usize) -> Settling {
 /// of the orbit's period finds the orbit all the same. `n` when no divisor does, or a flow
 /// fails. On any [`DiscreteMap`] (Pᵈ by [`DiscreteMap::iterate`]; the steady-state search
 /// gives the period-1 stroboscopic map of its integrator).
-pub fn minimal_period(dmap: &mut dyn DiscreteMap, z: &DVector<f64>, n: usize, tol: f64) -> usize {
+pub(crate) fn minimal_period(
+    dmap: &mut dyn DiscreteMap,
+    z: &DVector<f64>,
+    n: usize,
+    tol: f64,
+) -> usize {
     for d in (1..n).filter(|d| n.is_multiple_of(*d)) {
         let Ok(state) = dmap.iterate(z, d) else {
             return n;

@@ -62,7 +62,7 @@ impl Default for ShootingOptions {
 impl ShootingOptions {
     /// These options for a period-`n` orbit.
     #[must_use]
-    pub fn with_period(self, n: usize) -> Self {
+    pub(crate) fn with_period(self, n: usize) -> Self {
         ShootingOptions { period: n, ..self }
     }
 }
@@ -248,7 +248,7 @@ pub struct PeriodicOrbit {
 }
 
 /// Eigenvalues of a monodromy matrix, sorted by decreasing modulus.
-pub fn floquet_multipliers(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
+pub(crate) fn floquet_multipliers(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
     let mut mu: Vec<Complex<f64>> = m.complex_eigenvalues().iter().copied().collect();
     mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
     mu

@@ -23,7 +23,7 @@ pub struct SteadyOptions {
     /// Relative tolerance for two returns to coincide.
     pub tol: f64,
     /// Cap on the transient, in drive periods; `None`: derived from the model's slowest free
-    /// decay ([`SteadyOptions::cap`], [`default_transient_cap`]).
+    /// decay (`SteadyOptions::cap`, [`default_transient_cap`]).
     pub max_periods: Option<usize>,
     /// Largest period searched (≤ 64).
     pub max_period: usize,
@@ -50,7 +50,7 @@ impl Default for SteadyOptions {
 
 /// Fewest drive periods of a derived transient cap ([`default_transient_cap`]): the cap that
 /// settles the paper's beam (Q ≈ 42, its slowest mode decaying by 1e-8 in 248 periods).
-pub const MIN_TRANSIENT_PERIODS: usize = 1_500;
+pub(crate) const MIN_TRANSIENT_PERIODS: usize = 1_500;
 
 /// Drive periods of free decay by the tolerance ([`decay_periods`]) above which a search
 /// decides by Newton from the transient ([`SteadyOptions::newton`]). Below, the returns repeat
@@ -63,22 +63,22 @@ pub(crate) const NEWTON_DECAY_PERIODS: f64 = 1_000.0;
 /// nonlinear orbit's leading Floquet multiplier may lie closer to the unit circle than the
 /// free decay e^{−π/Q} (near a fold); six times covers the margins measured on the
 /// RTESPA-300 probe (Q = 500), whose returns repeat to 1e-8 within 3 000 – 12 000 periods.
-pub const TRANSIENT_DECAY_TIMES: f64 = 6.0;
+pub(crate) const TRANSIENT_DECAY_TIMES: f64 = 6.0;
 
 /// Drive periods the slowest free mode of the cantilever takes to decay by the factor `tol`:
 /// ln(1/tol)/(|Re λ| T), λ the damped eigenvalue with the smallest |Re λ| (eqs. 20–21) and T
 /// the drive period — ≈ Q ln(1/tol)/π for a lever of quality factor Q driven at resonance.
 /// `None` for a system without a free decay rate ([`TipSampleSystem::free_decay_rate`]) or an
 /// undamped one.
-pub fn decay_periods(system: &dyn TipSampleSystem, tol: f64) -> Option<f64> {
+pub(crate) fn decay_periods(system: &dyn TipSampleSystem, tol: f64) -> Option<f64> {
     let slowest = system.free_decay_rate()?;
     let decay = (1.0 / tol).ln() / (slowest * system.period());
     (decay.is_finite() && decay > 0.0).then_some(decay)
 }
 
 /// The default cap on a steady-state search's transient, the one rule of every analysis that
-/// waits for a steady state: [`TRANSIENT_DECAY_TIMES`] × [`decay_periods`], within
-/// [[`MIN_TRANSIENT_PERIODS`], [`MAX_STEADY_PERIODS`]] (the floor for a system without a
+/// waits for a steady state: `TRANSIENT_DECAY_TIMES` × `decay_periods`, within
+/// [`MIN_TRANSIENT_PERIODS`, [`MAX_STEADY_PERIODS`]] (the floor for a system without a
 /// decay rate). The paper's beam keeps 1 500 periods; the RTESPA-300 (Q = 500) gets 17 600.
 pub fn default_transient_cap(system: &dyn TipSampleSystem, tol: f64) -> usize {
     let Some(decay) = decay_periods(system, tol) else {
@@ -92,14 +92,14 @@ pub fn default_transient_cap(system: &dyn TipSampleSystem, tol: f64) -> usize {
 impl SteadyOptions {
     /// The transient cap on `system`: `max_periods` when given, else
     /// [`default_transient_cap`].
-    pub fn cap(&self, system: &dyn TipSampleSystem) -> usize {
+    pub(crate) fn cap(&self, system: &dyn TipSampleSystem) -> usize {
         self.max_periods
             .unwrap_or_else(|| default_transient_cap(system, self.tol))
     }
 
     /// Whether the search decides by Newton from the transient on `system` (see
     /// [`SteadyOptions::newton`]).
-    pub fn newton_on(&self, system: &dyn TipSampleSystem) -> bool {
+    pub(crate) fn newton_on(&self, system: &dyn TipSampleSystem) -> bool {
         self.newton && decay_periods(system, self.tol).is_some_and(|d| d > NEWTON_DECAY_PERIODS)
     }
 }
@@ -469,8 +469,8 @@ fn record(
 
 /// The steady state from the integrator's current state: iterate the stroboscopic map until
 /// the returns repeat with some period n ≤ `max_period` (then record one cycle) or the
-/// transient cap [`SteadyOptions::cap`] is reached (then record `nonperiodic_record` periods as
-/// a nonperiodic motion). On a slowly decaying model ([`SteadyOptions::newton_on`]) Newton
+/// transient cap `SteadyOptions::cap` is reached (then record `nonperiodic_record` periods as
+/// a nonperiodic motion). On a slowly decaying model (`SteadyOptions::newton_on`) Newton
 /// shooting from the transient is tried beside the returns' test ([`super::settle`], within
 /// the cap), and whichever decides first ends the search: a motion seen to go to a stable
 /// period-n orbit is recorded on the orbit (its Poincaré points the orbit's to the shooting

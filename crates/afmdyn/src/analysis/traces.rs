@@ -52,7 +52,7 @@ pub struct Traces {
 /// # Errors
 /// [`SimError::OutOfRange`] naming `trace_samples` outside 2..=`MAX_TRACE_SAMPLES`; the
 /// model's or integrator's errors for a point.
-pub fn traces(
+pub(crate) fn traces(
     base: &Params,
     param: SweepParam,
     integrator: IntegratorOptions,

@@ -196,7 +196,7 @@ pub struct Meniscus {
 impl Meniscus {
     /// The meniscus of force F̃_cap = `capillary`, immersion h̃ = `meniscus` and rupture distance
     /// D̃_r = `rupture` (each > 0).
-    pub fn new(capillary: f64, meniscus: f64, rupture: f64) -> Meniscus {
+    pub(crate) fn new(capillary: f64, meniscus: f64, rupture: f64) -> Meniscus {
         Meniscus {
             capillary,
             meniscus,
@@ -206,7 +206,7 @@ impl Meniscus {
 
     /// The pull and dF/dD: F = −F̃_cap(1 − D/√(D² + h̃²)), dF/dD = F̃_cap h̃²/(D² + h̃²)^{3/2}
     /// for D > 0; −F̃_cap and 0 in contact (D ≤ 0).
-    pub fn force(&self, d: f64) -> (f64, f64) {
+    pub(crate) fn force(&self, d: f64) -> (f64, f64) {
         if d <= 0.0 {
             return (-self.capillary, 0.0);
         }
@@ -219,14 +219,14 @@ impl Meniscus {
 
     /// The potential ∫_D^{D̃_r} F dD′ (0 at rupture, F = −dU/dD): −F̃_cap(G(D̃_r) − G(D)),
     /// G(D) = D − √(D² + h̃²), for D ≥ 0, and F̃_cap D more in contact (D < 0).
-    pub fn potential(&self, d: f64) -> f64 {
+    pub(crate) fn potential(&self, d: f64) -> f64 {
         let g = |d: f64| d - d.hypot(self.meniscus);
         -self.capillary * (g(self.rupture) - g(d.max(0.0))) + self.capillary * d.min(0.0)
     }
 
     /// The energy the meniscus takes per tap (formed at contact, ruptured at D̃_r):
     /// E_cap = −U(0) = ∫_0^{D̃_r} |F| dD = F̃_cap(D̃_r + h̃ − √(D̃_r² + h̃²)) (module docs).
-    pub fn hysteresis(&self) -> f64 {
+    pub(crate) fn hysteresis(&self) -> f64 {
         self.capillary * (self.rupture + self.meniscus - self.rupture.hypot(self.meniscus))
     }
 }

@@ -106,7 +106,7 @@ impl Law for JkrLaw {
     }
 }
 
-/// JKR's prepare step (`Law::prepare`): the contact's constants ([`Jkr::new`]: two square
+/// JKR's prepare step (`Law::prepare`): the contact's constants (`Jkr::new`: two square
 /// roots and a cube root of α4 and P̃) with the Kelvin–Voigt group α6. No force outside
 /// contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -158,13 +158,13 @@ pub struct Jkr {
 /// δ_b = δ_f (1 − 2.0e-6). At the end dF/dδ ∝ 1/√(δ − δ_f) is unbounded, and the variational
 /// equations (orbits, multipliers, shooting) stall on it (steps of 1e-17 measured); at the cut
 /// it is finite (1/(4q_b³ − c) = 1/(3.0e-3 c)). The break force is (5/6)P̃(1 + 2.4e-3) and
-/// E_hys is 1.2e-6 lower, relatively ([`Jkr::hysteresis`] is that of the cut branch,
+/// E_hys is 1.2e-6 lower, relatively (`Jkr::hysteresis` is that of the cut branch,
 /// [`Jkr::hysteresis_uncut`] the closed form).
 pub const JKR_BREAK_CUT: f64 = 1e-3;
 
 impl Jkr {
     /// The contact of Hertz group `alpha4` > 0 and adhesion `adhesion` = P̃ > 0.
-    pub fn new(alpha4: f64, adhesion: f64) -> Jkr {
+    pub(crate) fn new(alpha4: f64, adhesion: f64) -> Jkr {
         let c = (8.0 * adhesion / (3.0 * alpha4)).sqrt();
         let q_end = (0.25 * c).cbrt();
         Jkr {
@@ -181,7 +181,7 @@ impl Jkr {
     /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) (`Jkr::radius_variable`). The force of
     /// [`JkrLaw`]'s `Law::force` in contact, from constants computed once
     /// ([`PreparedJkr`]).
-    pub fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
+    pub(crate) fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
         let q = self.radius_variable(delta);
         let (f, df_dq) = self.elastic(q);
         let q2 = q * q;
@@ -212,7 +212,7 @@ impl Jkr {
     }
 
     /// δ(q) = q⁴ − c q.
-    pub fn indentation(&self, q: f64) -> f64 {
+    pub(crate) fn indentation(&self, q: f64) -> f64 {
         let q2 = q * q;
         q2 * q2 - self.c * q
     }
@@ -220,7 +220,7 @@ impl Jkr {
     /// The indentation where the contact breaks, δ_b = δ(q_b) < 0 ([`JKR_BREAK_CUT`]), with
     /// δ_f = −3q_f⁴ the end of the branch (the fixed-grips pull-off, −(3/4)(π²W²R/E*²)^{1/3}
     /// in SI).
-    pub fn release(&self) -> f64 {
+    pub(crate) fn release(&self) -> f64 {
         self.indentation(self.q_break)
     }
 
@@ -230,7 +230,7 @@ impl Jkr {
     }
 
     /// The elastic–adhesive force F(q) = α4 q⁶ − b q³ and dF/dq.
-    pub fn elastic(&self, q: f64) -> (f64, f64) {
+    pub(crate) fn elastic(&self, q: f64) -> (f64, f64) {
         let q3 = q * q * q;
         (
             self.alpha4 * q3 * q3 - self.b * q3,
@@ -255,12 +255,12 @@ impl Jkr {
 
     /// The energy lost per contact cycle (formed at δ = 0, broken at δ_b) by the
     /// elastic–adhesive force alone: E_hys = −U(q_contact).
-    pub fn hysteresis(&self) -> f64 {
+    pub(crate) fn hysteresis(&self) -> f64 {
         -self.potential(self.q_contact())
     }
 
     /// The closed form of the uncut branch (broken at δ_f): E_hys = (3/5 + 4^{−1/3}/10) P̃
-    /// c^{4/3} (module docs), 1.2e-6 above [`Jkr::hysteresis`] relatively.
+    /// c^{4/3} (module docs), 1.2e-6 above `Jkr::hysteresis` relatively.
     pub fn hysteresis_uncut(&self) -> f64 {
         (0.6 + 0.1 / 4f64.cbrt()) * self.adhesion * self.c.powf(4.0 / 3.0)
     }

@@ -57,11 +57,11 @@ pub(crate) use as_given;
 
 /// A [`TipSample`] with its law's derived constants prepared once ([`ContactLaw::prepare`]:
 /// each law's own [`Law::prepare`], e.g. JKR's c, b, q_f, q_b — two square roots and a cube
-/// root of α4 and P̃, [`super::Jkr::new`] — and DMT's adhesion −H̃/ã₀²) instead of at every
+/// root of α4 and P̃, `super::Jkr::new` — and DMT's adhesion −H̃/ã₀²) instead of at every
 /// force evaluation. Every evaluation is the law's own ([`TipSampleLaw`] of [`TipSample`]) with
 /// the same operations in the same order, so the same numbers bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PreparedLaw {
+pub struct PreparedLaw {
     ts: TipSample,
     /// The law's constants ([`ContactLaw::prepare`] of α4 and α6).
     prepared: PreparedContact,

@@ -144,7 +144,7 @@ pub struct Zener {
 
 impl Zener {
     /// The SLS of the model's α4, α6 and the law's κ.
-    pub fn new(alpha4: f64, maxwell: f64, alpha6: f64) -> Zener {
+    pub(crate) fn new(alpha4: f64, maxwell: f64, alpha6: f64) -> Zener {
         Zener {
             relaxed: alpha4,
             maxwell,
@@ -162,7 +162,7 @@ impl Zener {
     }
     /// s(u) = κu/(α4 + κ): where the free surface sits (a depression, g₀), balanced between
     /// its springs. The switching function is V_T + s(u) in both regions.
-    pub fn surface(&self, u: f64) -> f64 {
+    pub(crate) fn surface(&self, u: f64) -> f64 {
         self.surface_gain() * u
     }
     /// The surface's depression δ_s: the indentation δ in contact, s(u) free.
@@ -190,7 +190,7 @@ impl Zener {
         }
     }
     /// u̇ = (κ/α6)(δ_s − u): the dashpot's rate, in contact and free.
-    pub fn rate(&self, contact: bool, delta: f64, u: f64) -> f64 {
+    pub(crate) fn rate(&self, contact: bool, delta: f64, u: f64) -> f64 {
         self.relaxation_rate() * (self.depression(contact, delta, u) - u)
     }
     /// U = ½α4 δ_s² + ½κ(δ_s − u)²: the energy stored in the sample's springs.
@@ -199,7 +199,7 @@ impl Zener {
         0.5 * self.relaxed * ds * ds + 0.5 * self.maxwell * (ds - u) * (ds - u)
     }
     /// α6 u̇²: the dashpot's dissipation rate (≥ 0).
-    pub fn dissipation(&self, contact: bool, delta: f64, u: f64) -> f64 {
+    pub(crate) fn dissipation(&self, contact: bool, delta: f64, u: f64) -> f64 {
         let r = self.rate(contact, delta, u);
         self.dashpot * r * r
     }

@@ -292,7 +292,7 @@ pub trait Integrator: Send {
         Ok(())
     }
     /// The integrals over the last step of the energy-balance rates of
-    /// [`crate::model::CantileverModel::power`] — [base work, beam dissipation, sample
+    /// `crate::model::CantileverModel::power` — [base work, beam dissipation, sample
     /// dissipation] — where the integrator has them in closed form; `None` (the default) where
     /// the caller integrates them by quadrature of the dense output. The exact propagator has
     /// them for whole grid steps (`integrate/exact/energy.rs`), the Taylor integrator from its
@@ -309,7 +309,7 @@ pub trait Integrator: Send {
     /// scan's piezo between drive periods, `crate::analysis::am_loop::scan_line`), so that
     /// after [`Integrator::reset`] the integrator steps as one built by
     /// [`crate::integrate::build`] for the changed model, bit for bit
-    /// ([`crate::model::CantileverModel::set_gap`]). `false` (the default, and for an α5 the
+    /// (`crate::model::CantileverModel::set_gap`). `false` (the default, and for an α5 the
     /// model refuses) where it cannot: the caller then builds an integrator of the changed
     /// model. The Taylor integrator can.
     fn set_gap(&mut self, alpha5: f64) -> bool {
@@ -364,7 +364,7 @@ pub trait AffineRegions {
     /// α5; `crate::model::CantileverModel::forcing_derivative`). With the step Jacobians J
     /// and the event shifts of `crate::system::saltation_with_shift` it gives the parameter
     /// sensitivity of a flow, s ← J s + this (see
-    /// [`crate::maps::flow::flow`]). `Ok(false)`, with `out`
+    /// `crate::maps::flow::flow`). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it for this step or parameter (the
     /// exact propagator provides it for Ω, α2 and α5).
     ///
@@ -382,7 +382,7 @@ pub trait AffineRegions {
     /// e^{A_r t}(z(τ0) − z_p(τ0)) with A_r independent of p, so over a whole stint the
     /// parameter sensitivity telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ)
     /// — one product per stint instead of one per step
-    /// ([`crate::maps::flow::flow`]). `Ok(false)`, with `out`
+    /// (`crate::maps::flow::flow`). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it (the exact propagator provides it
     /// for Ω, α2 and α5).
     ///
@@ -419,7 +419,7 @@ pub trait Spans {
     /// `tau_max` or at an event, and — given a body-contact check `body` — only while the
     /// integrator shows, without forming the state, that no station of the beam body reaches
     /// the substrate at any time of the span (so that a caller testing
-    /// [`BodyContactCheck::touches`] after every step tests the span's end only). After it,
+    /// `BodyContactCheck::touches` after every step tests the span's end only). After it,
     /// the last step of the dense output, [`Integrator::last_step_rate_integrals`] and
     /// [`Integrator::last_step_jacobian`] is the whole span. The default takes one step; the
     /// exact propagator runs the steps of a stint in one loop (`integrate/exact/span.rs`), so
@@ -559,7 +559,7 @@ impl<'a> Observed<'a> {
         Observed { integ }
     }
     /// The system integrated.
-    pub fn system(&self) -> &dyn TipSampleSystem {
+    pub(crate) fn system(&self) -> &dyn TipSampleSystem {
         self.integ.system()
     }
     /// Current time τ.
@@ -571,13 +571,13 @@ impl<'a> Observed<'a> {
         self.integ.region()
     }
     /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state (`tip_values`).
-    pub fn tip_values(&mut self) -> [f64; 4] {
+    pub(crate) fn tip_values(&mut self) -> [f64; 4] {
         tip_values(self.integ)
     }
     /// An upper bound of Σ_j c_j |a_j| at the current state, possibly a looser one below
     /// `enough` ([`Spans::displacement_bound`] where the integrator has spans, else the sum
     /// formed from the state, [`crate::model::weighted_displacement`]).
-    pub fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
+    pub(crate) fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
         match self.integ.spans() {
             Some(s) => s.displacement_bound(weights, enough),
             None => crate::model::weighted_displacement(weights, self.integ.state().as_slice()),
@@ -589,11 +589,11 @@ impl<'a> Observed<'a> {
         self.integ.state()
     }
     /// [`Integrator::dense_tip`] inside the last step.
-    pub fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+    pub(crate) fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
         self.integ.dense_tip(tau)
     }
     /// [`Integrator::dense_v_t`] inside the last step.
-    pub fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+    pub(crate) fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
         self.integ.dense_v_t(tau)
     }
 }

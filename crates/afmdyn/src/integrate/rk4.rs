@@ -40,7 +40,7 @@ enum Mode {
 
 impl<S: TipSampleSystem + Clone> Rk4<S> {
     /// `steps` fixed steps per drive period; `locate_events` as in the module docs.
-    pub fn new(model: &S, steps: usize, locate_events: bool) -> Self {
+    pub(crate) fn new(model: &S, steps: usize, locate_events: bool) -> Self {
         let dim = model.dim();
         let z = DVector::zeros(dim);
         Rk4 {

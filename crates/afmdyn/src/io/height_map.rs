@@ -27,7 +27,7 @@ pub use super::caps::{MAX_CSV_BYTES, MAX_NPY_BYTES, MAX_NPY_HEADER_BYTES, MAX_PI
 
 /// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
 /// topography the z piezo follows.
-pub(crate) const MAX_HEIGHT: f64 = 1e-5;
+pub const MAX_HEIGHT: f64 = 1e-5;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.

@@ -19,14 +19,14 @@ pub const MAX_INPUT_TEXT_BYTES: u64 = 1024 * 1024;
 pub const MAX_INPUT_CSV_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest JSON document read back (`afmdyn reconstruct --fm fm.json`, `--am approach.json`), in
 /// bytes: 256 MiB, parsed as it is read (never held as text).
-pub(crate) const MAX_INPUT_DOCUMENT_BYTES: u64 = 256 * 1024 * 1024;
+pub const MAX_INPUT_DOCUMENT_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest file of records of a store read back (`--resume`: a sweep's partial and finished
 /// CSV, a study's records), in bytes: 128 GiB, above the largest store a request may make — a
 /// sweep of [`crate::analysis::bifurcation::MAX_SWEEP_POINTS`] (10⁶) points of up to
 /// [`crate::analysis::period::MAX_PERIOD`] (64) rows of at most 2 KiB (a 20-mode state in full
 /// precision) is 128 GiB at most, a chart of 10⁶ cells with 64 attractors of 2 KiB 128 GiB.
 /// Stores are streamed line by line, never held whole.
-pub(crate) const MAX_STORE_BYTES: u64 = 128 * 1024 * 1024 * 1024;
+pub const MAX_STORE_BYTES: u64 = 128 * 1024 * 1024 * 1024;
 /// Largest line of a study's records (`.chart.tiles.jsonl`, `.image.lines.jsonl`, …), in
 /// bytes: 1 GiB, above the largest record — a chart tile of
 /// [`crate::request::chart::MAX_CHART_TILE`] (10⁴) cells with
@@ -39,10 +39,10 @@ pub(crate) const MAX_STORE_LINE_BYTES: u64 = 1024 * 1024 * 1024;
 /// whose height map of 4096 × 4096 values takes at most the 512 MiB of its CSV
 /// ([`super::caps::MAX_CSV_BYTES`]), and 1 MiB ([`MAX_INPUT_TEXT_BYTES`]) for the probe and
 /// the request. Parsed as it is read (never held as text).
-pub(crate) const MAX_LEDGER_BYTES: u64 = super::caps::MAX_CSV_BYTES + MAX_INPUT_TEXT_BYTES;
+pub const MAX_LEDGER_BYTES: u64 = super::caps::MAX_CSV_BYTES + MAX_INPUT_TEXT_BYTES;
 /// Largest lock file of a store read (its holder's process id, when a run finds the store
 /// locked), in bytes: 4 KiB (the lock holds one short line, `12345 afmdyn`).
-pub(crate) const MAX_LOCK_BYTES: u64 = 4096;
+pub const MAX_LOCK_BYTES: u64 = 4096;
 /// Longest line of a CSV input, in bytes: 1 MiB, eight times a row of 4096 full-precision
 /// heights; a CSV parser holds a line whole, so a file without line ends (`/dev/zero`) is
 /// refused after this much.

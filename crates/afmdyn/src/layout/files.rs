@@ -1,6 +1,6 @@
 //! Files written atomically: every finished file goes to a temporary name in the same
 //! directory and is renamed into place, so a partial file is never mistaken for a finished one
-//! (a [`Stream`] dropped unfinished removes its temporary file), and every I/O error names its
+//! (a `Stream` dropped unfinished removes its temporary file), and every I/O error names its
 //! path ([`FileError`]). The tables: streamed CSV (`csv_stream`, `csv_line` with every
 //! number in its shortest round-trip form, `f`) and streamed 2-D float64 NPY arrays
 //! ([`NpyStream`], the NPY format of numpy's `format.py`, byte for byte `npyz`'s writer) with
@@ -74,7 +74,7 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
 
 /// A file written progressively (streamed) to its temporary name and renamed into place by
 /// [`Stream::finish`]; dropped unfinished, the temporary file is removed.
-pub struct Stream<W> {
+pub(crate) struct Stream<W> {
     path: PathBuf,
     tmp: PathBuf,
     inner: Option<W>,
@@ -100,17 +100,20 @@ impl<W> Stream<W> {
     }
 
     /// The writer; errors from it should go through [`Stream::err`].
-    pub fn get(&mut self) -> &mut W {
+    pub(crate) fn get(&mut self) -> &mut W {
         self.inner.as_mut().expect("open stream")
     }
 
     /// A write error on this file.
-    pub fn err(&self, e: impl Display) -> FileError {
+    pub(crate) fn err(&self, e: impl Display) -> FileError {
         io_error("write", &self.path, e)
     }
 
     /// Close the writer with `close` and rename the file into place.
-    pub fn finish(mut self, close: impl FnOnce(W) -> Result<(), String>) -> Result<(), FileError> {
+    pub(crate) fn finish(
+        mut self,
+        close: impl FnOnce(W) -> Result<(), String>,
+    ) -> Result<(), FileError> {
         let inner = self.inner.take().expect("open stream");
         close(inner).map_err(|e| io_error("write", &self.path, e))?;
         fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))?;
@@ -426,7 +429,7 @@ pub(crate) enum Field<'a> {
 }
 
 /// Append the lines in `bytes` (whole rows, from `csv_line`) to a streamed CSV table.
-pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), FileError> {
+pub(crate) fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), FileError> {
     // the csv writer's own buffer is written out first, so that the rows stay in order
     if bytes.is_empty() {
         return Ok(());

@@ -34,7 +34,7 @@ pub struct FlowMap {
     /// change (for an affine region ln det e^{A t} = t trace A, Liouville), from one determinant
     /// of the product.
     pub log_volume: f64,
-    /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow`]) and
+    /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for (`flow`) and
     /// the integrator provides it ([`crate::integrate::AffineRegions::last_step_param_derivative_into`] per step,
     /// [`crate::integrate::AffineRegions::region_particular_param_derivative_into`] per stint); else `None`.
     pub param_derivative: Option<DVector<f64>>,
@@ -54,7 +54,7 @@ pub struct FlowMap {
 ///
 /// # Errors
 /// [`SimError`] from the integrator, [`SimError::Unsupported`] for one without step Jacobians.
-pub fn flow(
+pub(crate) fn flow(
     integ: &mut dyn Integrator,
     tau0: f64,
     z0: &DVector<f64>,
@@ -335,7 +335,7 @@ pub(crate) fn grazing_distance(
 /// off (an integrator whose step control sees them — the adaptive one — then takes its own
 /// steps, a seventh of the work of a variational step at N = 3): for finite differences of the
 /// map, whose flows must all take steps chosen alike, not for the `state` of
-/// [`flow`].
+/// `flow`.
 ///
 /// # Errors
 /// [`SimError`] from the integrator.

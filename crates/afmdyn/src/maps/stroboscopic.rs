@@ -16,8 +16,8 @@ use nalgebra::DVector;
 /// (Jacobian on, grazing watched, no parameter derivative) and its options, then applied to
 /// states `z: [f64; 2N]` = (a, ȧ).
 ///
-/// * [`StroboscopicMap::apply`]: Pⁿ(z) with the monodromy matrix ∂Pⁿ/∂z (2N×2N) and, as
-///   asked for, ∂Pⁿ/∂p ([`StroboscopicMap::with_param_derivative`]) and the distance to grazing
+/// * `StroboscopicMap::apply`: Pⁿ(z) with the monodromy matrix ∂Pⁿ/∂z (2N×2N) and, as
+///   asked for, ∂Pⁿ/∂p (`StroboscopicMap::with_param_derivative`) and the distance to grazing
 ///   ([`StroboscopicMap::watch_grazing`]), in a [`FlowMap`];
 /// * [`StroboscopicMap::image`]: Pⁿ(z) alone, the Jacobian off (variational equations off);
 /// * [`StroboscopicMap::grazing_distance`]: the distance to grazing alone.
@@ -73,7 +73,7 @@ impl<'a> StroboscopicMap<'a> {
         }
     }
 
-    /// Watch the distance to grazing ([`FlowMap::grazing_distance`]) in [`Self::apply`] (the
+    /// Watch the distance to grazing ([`FlowMap::grazing_distance`]) in `Self::apply` (the
     /// default) or not (then NaN): the iterates of a Newton solve need the state and the
     /// monodromy matrix only, and the converged point takes [`Self::grazing_distance`] once
     /// (the local-extremum searches of V_T are a sixth of a period-1 shooting solve at N = 3).
@@ -89,7 +89,7 @@ impl<'a> StroboscopicMap<'a> {
     /// for p = Ω the moving end time nT = 2πn/Ω, which adds ż(nT) d(nT)/dΩ = −ż(nT) nT/Ω.
     /// `None` there when the integrator or the law does not provide it.
     #[must_use]
-    pub fn with_param_derivative(mut self, param: SweepParam) -> Self {
+    pub(crate) fn with_param_derivative(mut self, param: SweepParam) -> Self {
         self.param = Some(param);
         self
     }
@@ -100,7 +100,7 @@ impl<'a> StroboscopicMap<'a> {
     }
 
     /// The duration nT of one iterate (dimensionless τ).
-    pub fn duration(&self) -> f64 {
+    pub(crate) fn duration(&self) -> f64 {
         self.duration_of(self.periods)
     }
 
@@ -126,7 +126,7 @@ impl<'a> StroboscopicMap<'a> {
     /// # Errors
     /// [`SimError`] from the integrator, [`SimError::Unsupported`] for one without step
     /// Jacobians.
-    pub fn apply(&mut self, z: &DVector<f64>) -> Result<FlowMap, SimError> {
+    pub(crate) fn apply(&mut self, z: &DVector<f64>) -> Result<FlowMap, SimError> {
         self.apply_over(z, self.periods, self.grazing)
     }
 
@@ -161,7 +161,7 @@ impl<'a> StroboscopicMap<'a> {
     /// Pⁿ(z) alone, with the variational equations switched off (an integrator whose step
     /// control sees them — the adaptive one — then takes its own steps, a seventh of the work
     /// of a variational step at N = 3): for finite differences of the map, whose flows must all
-    /// take steps chosen alike, not for the `state` of [`Self::apply`].
+    /// take steps chosen alike, not for the `state` of `Self::apply`.
     ///
     /// # Errors
     /// [`SimError`] from the integrator.
@@ -171,7 +171,7 @@ impl<'a> StroboscopicMap<'a> {
     }
 
     /// The distance to grazing of Pⁿ(z) ([`FlowMap::grazing_distance`]) without the Jacobian:
-    /// the same steps and searches as a watched [`Self::apply`], so the same value.
+    /// the same steps and searches as a watched `Self::apply`, so the same value.
     ///
     /// # Errors
     /// [`SimError`] from the integrator.
@@ -184,7 +184,7 @@ impl<'a> StroboscopicMap<'a> {
 /// The period-n map as a [`DiscreteMap`]: one iterate spans [`StroboscopicMap::periods`] drive
 /// periods, and Pᵏ is one flow over k·n periods (the same flow as the inherent methods of a map
 /// of k·n periods, so the same numbers); the parameter derivative as set by
-/// [`StroboscopicMap::with_param_derivative`].
+/// `StroboscopicMap::with_param_derivative`.
 impl DiscreteMap for StroboscopicMap<'_> {
     fn dim(&self) -> usize {
         self.integ().system().dim()

@@ -17,7 +17,7 @@ pub struct BodyContactCheck {
 
 impl BodyContactCheck {
     /// Sample the beam at `points` interior stations ξ_i = 0.99 i / points, i = 1..=points.
-    pub fn new(model: &CantileverModel, points: usize) -> Self {
+    pub(crate) fn new(model: &CantileverModel, points: usize) -> Self {
         let n = model.modes();
         let shapes = model.galerkin().shapes();
         // the point-mass and eigenmode models have no beam body
@@ -52,7 +52,7 @@ impl BodyContactCheck {
     /// case away from the sample. Otherwise the stations are formed one by one, each sum in
     /// the order of the matrix–vector product (mode 0 first), without allocating.
     /// `z: [f64; 2N]` as (a, ȧ), of the model the check was built for.
-    pub fn touches(&self, tau: f64, z: &DVector<f64>) -> bool {
+    pub(crate) fn touches(&self, tau: f64, z: &DVector<f64>) -> bool {
         self.touches_at(self.base(tau), &z.as_slice()[..self.reach.len()])
     }
 
@@ -99,7 +99,7 @@ impl BodyContactCheck {
 
 /// Σ_j c_j |a_j| over `weights` c (≥ 0) and the leading entries of `a` (the modal
 /// displacements of a state (a, ȧ)), in index order.
-pub fn weighted_displacement(weights: &[f64], a: &[f64]) -> f64 {
+pub(crate) fn weighted_displacement(weights: &[f64], a: &[f64]) -> f64 {
     weights.iter().zip(a).map(|(c, x)| c * x.abs()).sum()
 }
 

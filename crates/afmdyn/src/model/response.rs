@@ -34,7 +34,7 @@ impl CantileverModel {
     /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c (plus the power F̃(τ) Ẇ(1,τ) of the further
     /// components of a multifrequency drive, `Params::component_force`) and D_contact = F_d δ̇ (F_d the dissipative part
     /// of the law).
-    pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
+    pub(crate) fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
         let n = self.modes();
         let p = &self.params;
         let g = self.galerkin.region(Region::Free);
@@ -76,7 +76,7 @@ impl CantileverModel {
 
     /// Complex amplitude H of the free steady response of the tip deflection (no sample force,
     /// the linear free system of eqs. 11–14): W(1,τ) = Im(H e^{i(Ωτ + ψ)}) with ψ the drive
-    /// phase ([`Params::drive_phase`]), so |H| is the free amplitude A₀ (units of g₀) and
+    /// phase (`Params::drive_phase`), so |H| is the free amplitude A₀ (units of g₀) and
     /// −arg H the phase lag behind the drive. From (K − Ω²M + iΩC) X = F_s + i F_c for the
     /// forcing F_s sin Ωτ + F_c cos Ωτ, H = φ(1)ᵀX e^{−iψ} (the harmonic-balance solution of a
     /// linear system, e.g. Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill 2001, §7.15).
@@ -95,7 +95,7 @@ impl CantileverModel {
     ///
     /// # Errors
     /// As [`CantileverModel::free_tip_response`].
-    pub fn free_tip_response_damping_derivative(
+    pub(crate) fn free_tip_response_damping_derivative(
         &self,
     ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
         use nalgebra::Complex;

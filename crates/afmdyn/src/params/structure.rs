@@ -16,7 +16,7 @@ pub struct Eigenmodes {
 
 impl Eigenmodes {
     /// The modal mass of mode j in the model's units (k_1 and ω_1 of 1): (k_j/k_1)/(ω_j/ω_1)².
-    pub fn mass(&self, j: usize) -> f64 {
+    pub(crate) fn mass(&self, j: usize) -> f64 {
         self.stiffness[j] / (self.frequency[j] * self.frequency[j])
     }
 }

@@ -81,7 +81,7 @@
 //! α2 = F₀/(k A₀) = √((1 − Ω²)² + (Ω/Q)²) (the harmonic oscillator's response).
 //! A multifrequency drive (`[drive]` arrays) adds, for every model, components F̃ᵢ cos(ωᵢτ) at
 //! the tip ([`crate::params::DriveComponent`]): ωᵢ/Ω is the fraction p/q with the smallest
-//! q ≤ 1000 within 1e-6 of fᵢ/f₁ ([`rational_ratio`]: a periodic drive), else the convergent
+//! q ≤ 1000 within 1e-6 of fᵢ/f₁ (`rational_ratio`: a periodic drive), else the convergent
 //! of fᵢ/f₁ with q ≤ 10⁶ (`convergent`: a quasi-periodic drive, within about 1e-12, whose
 //! response the time average measures); the frequency used is reported; and
 //! F̃ᵢ = A₀ᵢ/(g₀|Hᵢ|) from the free tip response Hᵢ to a unit tip force at ωᵢ
@@ -125,7 +125,7 @@ pub use crate::contact::VACUUM_PERMITTIVITY;
 
 /// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
 /// (Israelachvili 2011, §13.6).
-pub const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
+pub(crate) const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
@@ -226,7 +226,7 @@ pub struct Scales {
 
 impl Scales {
     /// Joules per unit energy (force × length).
-    pub fn energy_j(&self) -> f64 {
+    pub(crate) fn energy_j(&self) -> f64 {
         self.force_n * self.length_m
     }
     /// Watts per unit power.
@@ -234,7 +234,7 @@ impl Scales {
         self.energy_j() / self.time_s
     }
     /// Frequency in Hz of a dimensionless angular frequency Ω.
-    pub fn frequency_hz(&self, omega: f64) -> f64 {
+    pub(crate) fn frequency_hz(&self, omega: f64) -> f64 {
         omega / (TAU * self.time_s)
     }
     /// Dimensionless Ω of a frequency in Hz.
@@ -388,7 +388,7 @@ pub(crate) const TABOR_DMT: f64 = 0.1;
 
 /// The surface tension of water at 25 °C, 0.07197 N/m (CRC Handbook of Chemistry and Physics,
 /// 97th ed. 2016, "Surface tension of common liquids"): the capillary law's default.
-pub const WATER_SURFACE_TENSION: f64 = 0.07197;
+pub(crate) const WATER_SURFACE_TENSION: f64 = 0.07197;
 
 /// The work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
 /// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
@@ -428,7 +428,7 @@ impl Probe {
     }
 
     /// The probe's own warnings, which every document of it carries
-    /// ([`crate::report::with_si`]): a DMT or electrostatic sample in JKR's regime (Tabor
+    /// (`crate::report::with_si`): a DMT or electrostatic sample in JKR's regime (Tabor
     /// parameter above `TABOR_JKR`), where DMT misses the contact's neck and the adhesion
     /// hysteresis.
     pub fn warnings(&self) -> Vec<String> {
@@ -468,7 +468,7 @@ pub struct DriveComponentSi {
 /// when there is none. A frequency moved by 1e-6 of itself moves the response of a mode of
 /// quality factor Q by 2Q·1e-6 rad in phase (2e-3 rad at Q = 1000); the frequency used is
 /// reported ([`DriveComponentSi::frequency`]).
-pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
+pub(crate) fn rational_ratio(r: f64) -> Option<(u32, u32)> {
     if !(r.is_finite() && r > 0.0 && r < 1e6) {
         return None;
     }
@@ -687,7 +687,7 @@ impl Probe {
     ///
     /// # Errors
     /// As [`Probe::parse`], but for the syntax.
-    pub fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
+    pub(crate) fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
         Self::from_table_for(root, origin, ProbeNeeds::Oscillation)
     }
 
@@ -760,7 +760,7 @@ impl Probe {
     }
 
     /// The rest distance z_c (m) of a parameter set under these scales.
-    pub fn z_c_of(&self, params: &Params) -> f64 {
+    pub(crate) fn z_c_of(&self, params: &Params) -> f64 {
         params.rest_distance() * self.scales.length_m
     }
 }

@@ -26,7 +26,7 @@ pub(crate) fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
 }
 
 /// √(Σ_{k≥2} A_k²)/A_1 of the eigenmodes' amplitudes A_k (0 for one mode; NaN without any).
-pub fn higher_mode_fraction(amplitudes: &[f64]) -> f64 {
+pub(crate) fn higher_mode_fraction(amplitudes: &[f64]) -> f64 {
     match amplitudes.split_first() {
         Some((a1, rest)) => rest.iter().fold(0.0, |s, a| s + a * a).sqrt() / a1,
         None => f64::NAN,
@@ -357,7 +357,11 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
 /// end adds the block through this one function. The probe's own warnings
 /// ([`crate::probe::Probe::warnings`]) join the document's `warnings` (made for them when the
 /// document has none).
-pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
+pub(crate) fn with_si(
+    mut doc: Value,
+    probe: Option<&crate::probe::Probe>,
+    params: &Params,
+) -> Value {
     if let Some(p) = probe {
         doc["si"] = si(p, params, &doc);
         if !p.assumed.is_empty() {
@@ -412,7 +416,7 @@ pub(crate) fn regime(mean_deflection: f64) -> &'static str {
 /// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
 /// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
 /// `CURVE_COLUMNS` of its orbit (interpolated between two time-averaged motions).
-pub fn setpoint(
+pub(crate) fn setpoint(
     params: &Params,
     c: &SteppedCurve,
     (points, dropped): (
@@ -525,7 +529,7 @@ fn around<'a>(
 
 /// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
 /// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
-pub(crate) fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let scale = u.hz_per_omega.unwrap_or(1.0);
     let key = if u.hz_per_omega.is_some() {
         "frequency_hz"

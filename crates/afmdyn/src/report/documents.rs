@@ -283,7 +283,7 @@ impl TextUnits {
         si_value(v, unit, self.plain)
     }
     /// The drive: `f = 300.000 kHz` or `Ω = 2.6`.
-    pub fn drive(self, omega: f64) -> String {
+    pub(crate) fn drive(self, omega: f64) -> String {
         match self.scales {
             Some(s) => format!("f = {}", self.value(s.frequency_hz(omega), "Hz")),
             None => format!("Ω = {omega}"),
@@ -297,14 +297,14 @@ impl TextUnits {
         }
     }
     /// A length in g₀: m, or g₀.
-    pub fn length(self, v: f64) -> String {
+    pub(crate) fn length(self, v: f64) -> String {
         match self.scales {
             Some(s) => self.value(v * s.length_m, "m"),
             None => format!("{v:.9}"),
         }
     }
     /// A rate per unit τ (a Lyapunov exponent, Re λ): 1/s, or per unit τ.
-    pub fn rate(self, v: f64) -> String {
+    pub(crate) fn rate(self, v: f64) -> String {
         match self.scales {
             Some(s) => format!("{:+.6e} 1/s", v / s.time_s),
             None => format!("{v:+.6}"),

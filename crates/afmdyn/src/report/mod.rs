@@ -31,7 +31,7 @@ pub(crate) fn region_spectrum(r: &RegionSpectrum) -> Value {
 }
 
 /// `afmdyn modes --json`: the parameters and the free and contact spectra (eqs. 19–23).
-pub fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -> Value {
+pub(crate) fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -> Value {
     json!({ "params": params, "free": region_spectrum(free), "contact": region_spectrum(contact) })
 }
 
@@ -51,7 +51,7 @@ pub struct SimulateSummary {
     pub body_contact: bool,
     /// Stroboscopic section points recorded.
     pub poincare_points: usize,
-    /// [`energy_residual`] of the run.
+    /// `energy_residual` of the run.
     pub energy_residual: (f64, f64),
 }
 
@@ -213,7 +213,7 @@ fn continuation_ids(steps: &[ContinuationStep]) -> usize {
 /// `basin_fraction` (0 where the id has no attractor), `period` (−1 nonperiodic, 0 absent),
 /// `x_max`, `v_t_min` (g0; NaN absent), `stable` (1/0 from the orbit's Floquet multipliers,
 /// NaN otherwise); over value `failures` (runs that failed).
-pub fn global_continuation_layout(param: SweepParam, steps: &[ContinuationStep]) -> Layout {
+pub(crate) fn global_continuation_layout(param: SweepParam, steps: &[ContinuationStep]) -> Layout {
     let (nv, ni) = (steps.len(), continuation_ids(steps));
     let mut fraction = vec![0.0; nv * ni];
     let mut period = vec![0; nv * ni];
@@ -277,7 +277,7 @@ pub fn global_continuation_layout(param: SweepParam, steps: &[ContinuationStep])
 
 /// `afmdyn attractors --sweep --json`: the attractors at every value with their ids, and the
 /// basin fractions as a values × ids table (0 where an id has no attractor).
-pub fn global_continuation(
+pub(crate) fn global_continuation(
     base: &Params,
     param: SweepParam,
     samples: usize,
@@ -332,7 +332,7 @@ pub fn global_continuation(
 }
 
 /// `afmdyn orbit --json`: a period-n orbit of `model` with its Floquet multipliers.
-pub fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
+pub(crate) fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
     let mut doc = json!({
         "period": o.period,
         "poincare": {
@@ -398,7 +398,7 @@ mod units;
 pub(crate) use branches::*;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
-pub use curves::*;
+pub(crate) use curves::*;
 pub use documents::*;
 pub use series::*;
 pub use units::*;
@@ -520,6 +520,6 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
 /// reaches both front ends): dimensionless units of the model (lengths g₀, time τ, forces F̃,
 /// energies F̃·g₀); phases in radians. Non-finite values (e.g. Q = ∞ without damping) become
 /// `null`.
-pub fn observables(o: &Observables) -> Value {
+pub(crate) fn observables(o: &Observables) -> Value {
     serde_json::to_value(o).expect("observables serialise")
 }

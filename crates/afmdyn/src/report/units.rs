@@ -38,7 +38,7 @@ impl CurveUnits {
 
     /// SI units from a probe's scales ([`crate::probe::Scales`]): metres, newtons, joules;
     /// frequencies in Hz when `hz` is set.
-    pub fn from_scales(s: &crate::probe::Scales, hz: bool) -> Self {
+    pub(crate) fn from_scales(s: &crate::probe::Scales, hz: bool) -> Self {
         CurveUnits {
             length: s.length_m,
             force: s.force_n,
@@ -83,7 +83,7 @@ impl CurveUnits {
 
 /// The units of a recorded trajectory's files and plots (`simulate`): the model's (τ, g₀, its
 /// force and energy units) or, with a probe, SI (s, m, m/s, N, J, Hz) from its scales
-/// ([`CurveUnits::from_scales`]). The one place a time series is converted; every factor
+/// (`CurveUnits::from_scales`). The one place a time series is converted; every factor
 /// multiplies a dimensionless value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SeriesUnits {
@@ -95,7 +95,7 @@ pub struct SeriesUnits {
 
 /// The names of [`SeriesUnits`]: the time column and the units of each kind of quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SeriesNames {
+pub(crate) struct SeriesNames {
     /// The time column: `t` (SI) or `tau`.
     pub time: &'static str,
     /// Its unit.
@@ -112,14 +112,14 @@ pub struct SeriesNames {
 
 impl SeriesUnits {
     /// The units of `params`' trajectories, SI when `probe` is given.
-    pub fn new(params: &Params, probe: Option<&crate::probe::Probe>) -> Self {
+    pub(crate) fn new(params: &Params, probe: Option<&crate::probe::Probe>) -> Self {
         SeriesUnits {
             u: CurveUnits::of(probe, true),
             point_mass: params.structure.is_lumped(),
         }
     }
     /// A time τ in the reported unit.
-    pub fn t(&self, tau: f64) -> f64 {
+    pub(crate) fn t(&self, tau: f64) -> f64 {
         tau * self.u.time
     }
     /// A length (g₀) in the reported unit.
@@ -139,7 +139,7 @@ impl SeriesUnits {
         v * self.u.energy
     }
     /// The names of the reported units.
-    pub fn names(&self) -> SeriesNames {
+    pub(crate) fn names(&self) -> SeriesNames {
         let (force, energy) = match (self.u.si, self.point_mass) {
             (true, _) => ("N", "J"),
             (false, true) => ("k g0", "k g0²"),
@@ -172,7 +172,7 @@ impl SeriesUnits {
 pub struct SeriesColumn {
     /// The name (`tau` or `t`, `v_t`, `w_tip`, …, `a_1`, `a_dot_1`, …).
     pub name: String,
-    /// Its unit ([`SeriesNames`]).
+    /// Its unit (`SeriesNames`).
     pub unit: &'static str,
     /// What it is.
     pub long_name: String,

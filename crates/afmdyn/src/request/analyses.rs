@@ -72,7 +72,7 @@ impl OrbitRequest {
     /// an unstable periodic orbit embedded in it.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`]; the
+    /// As [`Self::validate`], `StartRequest::guess` and [`shoot`]; the
     /// [`SimError::NoConvergence`] of the last search tried when none converges, or
     /// [`SimError::NoPeriod`] when the period was not given and the steady-state search from
     /// the start found none.
@@ -183,7 +183,7 @@ impl ContinuationRequest {
     /// The branches: one without `switch`, the cascade with it.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`StartRequest::guess`], [`crate::analysis::continuation::continue_branch`] and
+    /// As [`Self::validate`], `StartRequest::guess`, [`crate::analysis::continuation::continue_branch`] and
     /// [`crate::analysis::continuation::continue_with_switching`].
     /// Every branch point is counted in `progress`, which also cancels the run.
     pub fn run(&self, base: &Params, progress: &Progress) -> Result<Vec<Branch>, SimError> {
@@ -238,7 +238,7 @@ impl LyapunovRequest {
     /// Check every option.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `periods` or `blocks` ([`LyapunovOptions::validate`]).
+    /// [`SimError::OutOfRange`] naming `periods` or `blocks` (`LyapunovOptions::validate`).
     pub fn validate(&self) -> Result<(), SimError> {
         let transient = self.transient.unwrap_or(MAX_STEADY_PERIODS);
         if transient as f64 + self.periods as f64 > MAX_RUN_PERIODS {
@@ -265,7 +265,7 @@ impl LyapunovRequest {
     /// `progress`, which also cancels the run.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`initial_state`] and [`lyapunov_spectrum_with`].
+    /// As [`Self::validate`], [`initial_state`] and `lyapunov_spectrum_with`.
     pub fn run(&self, params: &Params, progress: &Progress) -> Result<LyapunovSpectrum, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;
@@ -510,7 +510,7 @@ impl ObserveRequest {
     /// `periods` of its periods.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`StartRequest::guess`] and [`observe_from`].
+    /// As [`Self::validate`], `StartRequest::guess` and `observe_from`.
     pub fn run(&self, params: &Params) -> Result<ObserveResult, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;

@@ -197,7 +197,7 @@ impl ChartModel {
     /// Metres per unit length of the cell at (`x`, `y`) under the probe: its free amplitude A₀
     /// (g₀ = A₀ for both structural models), the axis value where an axis is `free_amplitude`;
     /// `None` without a probe (lengths stay in g₀).
-    pub fn length_m(&self, x: f64, y: f64) -> Option<f64> {
+    pub(crate) fn length_m(&self, x: f64, y: f64) -> Option<f64> {
         let probe = self.probe.as_ref()?;
         Some(if self.x == "free_amplitude" {
             x
@@ -491,7 +491,7 @@ pub(crate) fn axis(name: &str) -> ChartAxis<'_> {
 }
 
 /// The rows of `cell` of `chart` as CSV lines of [`CSV_HEADER`], lengths in g₀ or, with a
-/// probe, in m ([`ChartModel::length_m`] of the cell).
+/// probe, in m (`ChartModel::length_m` of the cell).
 pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
     let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
     crate::report::chart_layout::csv_lines(length, cell)

@@ -260,7 +260,7 @@ pub(crate) fn check_single_frequency(base: &Params, what: &'static str) -> Resul
 }
 
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
-/// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
+/// unit Ω, or 1): `mode_band` for missing ends, `resonance_spec`, then
 /// `CurveRequest::configure`.
 ///
 /// # Errors

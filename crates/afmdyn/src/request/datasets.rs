@@ -309,7 +309,7 @@ impl Datasets for BasinsRequest {
 }
 
 impl Datasets for GlobalContinuationRequest {
-    /// The continuation's layout ([`report::global_continuation_layout`]).
+    /// The continuation's layout (`report::global_continuation_layout`).
     fn datasets(&self, _: &Resolved, steps: &Self::Output) -> Arrays {
         one(
             "global_continuation",

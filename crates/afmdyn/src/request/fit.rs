@@ -588,7 +588,7 @@ impl Analysis for FitRequest {
     }
     /// A force curve uses the probe's spring constant, tip and sample only; an AM, FM or
     /// bimodal curve refuses the values a quasi-static read stood in for
-    /// ([`super::fit_dynamic::am_probe`]).
+    /// (`super::fit_dynamic::am_probe`).
     fn probe_needs(&self) -> crate::probe::ProbeNeeds {
         crate::probe::ProbeNeeds::Static
     }

@@ -464,7 +464,7 @@ impl DynamicModel {
 /// [`SimError::OutOfRange`] naming `probe` and the keys a quasi-static read stood in for
 /// ([`crate::probe::Probe::assumed`]: a dynamic curve needs the lever's resonance, Q and
 /// drive), or the first of E_s, ν_s, E_t, ν_t and R the probe lacks.
-pub fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
+pub(crate) fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
     if !probe.assumed.is_empty() {
         return Err(SimError::out_of_range(
             "probe",

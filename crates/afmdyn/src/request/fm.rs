@@ -83,10 +83,10 @@ pub(crate) const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
 /// and the computed curve's first point sits a little above it (1.0033 % where the two were
 /// equal), so a default `fm` curve handed to `reconstruct` must start with a margin below
 /// the threshold, not on it.
-pub const FM_DEFAULT_DECAY: f64 = super::reconstruct::DECAYED / 2.0;
+pub(crate) const FM_DEFAULT_DECAY: f64 = super::reconstruct::DECAYED / 2.0;
 
 /// The default first z_c of an FM curve at amplitude `a` ending at `to` (units of g₀): the
-/// largest z_c whose estimated frequency shift is still [`FM_DEFAULT_DECAY`] of its value at
+/// largest z_c whose estimated frequency shift is still `FM_DEFAULT_DECAY` of its value at
 /// `to` (by bisection to round-off), from Giessibl's first-order shift, which is
 /// proportional to the cosine-weighted mean force over a cycle,
 /// Δf ∝ −⟨F(z_c + A cos θ) cos θ⟩_θ (Giessibl, *Phys. Rev. B* 56, 16010 (1997), eq. 11;

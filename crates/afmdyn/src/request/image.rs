@@ -52,7 +52,7 @@ mod sample;
 mod study;
 pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy, MAX_STUDY_RATIOS};
 
-pub(crate) use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
+pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
 /// Largest number of domains of a sample map.
 pub(crate) const MAX_DOMAINS: usize = 1000;
@@ -177,7 +177,7 @@ pub enum Regime {
 }
 
 /// One operating point of a material at the setpoint, in SI: the rest distance and the
-/// observables interpolated there ([`crate::report::setpoint`]).
+/// observables interpolated there (`crate::report::setpoint`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OperatingPoint {
     /// `approach` or `retract`: the sweep it lies on.
@@ -701,7 +701,7 @@ impl Image {
     }
 
     /// Apparent height of a pixel (m): h + z_c − z_c,ref (NaN where not reached).
-    pub fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
+    pub(crate) fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
         let p = &self.pixels[line][pixel];
         self.point(line, pixel)
             .map_or(f64::NAN, |o| p.height + o.z_c - self.reference)

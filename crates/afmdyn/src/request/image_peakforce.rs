@@ -648,7 +648,7 @@ pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
 
 impl PeakForceImage {
     /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
-    pub fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
+    pub(crate) fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
         self.pixels[line][pixel].tap.as_ref()
     }
 

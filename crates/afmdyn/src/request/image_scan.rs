@@ -14,7 +14,7 @@
 //! **Units.** A request is in SI: the scan rate in Hz (lines per second, each a trace and a
 //! retrace, as instruments count it), K_P dimensionless (m of z per m of amplitude error), K_I
 //! in 1/s (m/s of z per m of error), the lock-in's time constant in s. The defaults derive from
-//! the lever ([`crate::analysis::am_loop::FeedbackGains::for_lever`]): τ_c = 2Q/ω₀, the
+//! the lever (`crate::analysis::am_loop::FeedbackGains::for_lever`): τ_c = 2Q/ω₀, the
 //! lock-in's time constant τ_c/4, K_I = 1/(4(τ_c + τ_L)), K_P = 0, and a pixel lasting
 //! [`PIXEL_LOOP_TIMES`] loop time constants 1/K_I (RTESPA-300, Q = 400 at 300 kHz, 64 pixels:
 //! 0.74 Hz).
@@ -24,7 +24,7 @@
 //! ideal image's reference z_c,ref, so that a perfect controller records the ideal image's
 //! apparent height), the mean lock-in amplitude and phase, the mean error A_sp − A (the error
 //! image), and E_dis, virial, peak force and indentation over the pixel's last drive period
-//! ([`crate::analysis::observables::observe`]).
+//! (`crate::analysis::observables::observe`).
 //!
 //! **Artefacts** ([`Artefacts`], per direction): the RMS and largest difference of the recorded
 //! height from the ideal image's apparent height; the overshoot, how far a recorded height goes
@@ -587,7 +587,7 @@ pub(crate) fn scan_cells(d: usize, shape: (usize, usize)) -> Vec<ScanCell> {
 
 impl PiImage {
     /// Metres per model length unit g₀ (the records' lengths).
-    pub fn length(&self) -> f64 {
+    pub(crate) fn length(&self) -> f64 {
         self.units.length
     }
 
@@ -612,7 +612,7 @@ impl PiImage {
 
     /// Recorded height (m) of pixel (j, i) in direction `d`: the mean piezo position less the
     /// ideal image's reference.
-    pub fn height(&self, d: usize, j: usize, i: usize) -> f64 {
+    pub(crate) fn height(&self, d: usize, j: usize, i: usize) -> f64 {
         self.row(d, j)[i].z * self.units.length - self.ideal.reference
     }
 

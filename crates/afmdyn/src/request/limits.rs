@@ -62,7 +62,7 @@ pub struct Cost {
 /// of an image (`MAX_IMAGE_BYTES` of `crate::request::image`, where 2048 × 2048 pixels aborted
 /// on allocation) and about that of a curve's traces (`MAX_TRACE_BYTES`): what a request and
 /// the copies a front end makes of its result (files, NumPy arrays) hold within a few GiB.
-pub const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
 
 /// Largest work of a request, estimated before it runs, in mode-periods (drive periods
 /// integrated × modes): 1e11, about four days on one core at N = 20 (59 µs a drive period,
@@ -70,7 +70,7 @@ pub const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
 /// law 6–37 µs). Above every request whose factors the options bound one by one
 /// ([`MAX_RUN_PERIODS`] × 20 modes × the 41 columns of a Lyapunov spectrum is 8.2e10), below
 /// their products (random starts × transient cap × cells, which reach 1e18).
-pub const MAX_REQUEST_WORK: f64 = 1e11;
+pub(crate) const MAX_REQUEST_WORK: f64 = 1e11;
 
 /// Depth of a period-doubling cascade followed by branch switching: periods n, 2n, 4n and 8n.
 pub const CASCADE_FACTOR: usize = 8;

@@ -45,7 +45,7 @@ pub mod fm;
 #[cfg(feature = "files")]
 pub use crate::io::height_map as height_map_file;
 pub mod fit;
-pub mod fit_dynamic;
+pub(crate) mod fit_dynamic;
 pub(crate) mod fit_result;
 pub mod image;
 pub mod image_job;

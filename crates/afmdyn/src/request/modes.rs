@@ -64,7 +64,7 @@ impl Analysis for ModesRequest {
 
 /// `modes --sweep fig3`: the paper's Fig. 3 maps, ω₁/ω₀₁ and ω₂/ω₀₂ of the contact system
 /// over the α1 × α4 grid (`crate::report::present::modes::fig3_alpha1` ×
-/// `crate::report::present::modes::fig3_alpha4`) at the model's N ([`crate::eigen::fig3_sweep`]).
+/// `crate::report::present::modes::fig3_alpha4`) at the model's N (`crate::eigen::fig3_sweep`).
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Fig3Request {

@@ -116,7 +116,7 @@ fn range_of(section: &str, key: &str) -> &'static crate::probe::ranges::SiRange 
 
 /// The share of its extreme that |Δf| may keep at the largest distance without the truncation
 /// warning: the inversion integrates Δf beyond each distance and stops at the data's end.
-pub const DECAYED: f64 = 0.01;
+pub(crate) const DECAYED: f64 = 0.01;
 
 impl ReconstructRequest {
     /// The curve to invert, in increasing distance.
@@ -185,7 +185,7 @@ impl ReconstructRequest {
 
     /// The document's warnings on the request: a constant outside its typical range (a likely
     /// unit slip, `CONSTANTS`); data that end before the shift has decayed (|Δf| at the largest
-    /// distance above [`DECAYED`] of its extreme).
+    /// distance above `DECAYED` of its extreme).
     pub fn warnings(&self) -> Vec<String> {
         let mut warnings: Vec<String> = CONSTANTS
             .iter()

@@ -107,8 +107,8 @@ pub trait Analysis {
     }
     /// What the request costs on `model` — peak memory and work in mode-periods
     /// (`super::costs`) — estimated for the worst case its options allow, before any work;
-    /// [`run`] refuses it beyond [`super::limits::MAX_REQUEST_BYTES`] or
-    /// [`super::limits::MAX_REQUEST_WORK`]. Called after [`Analysis::validate`].
+    /// [`run`] refuses it beyond `super::limits::MAX_REQUEST_BYTES` or
+    /// `super::limits::MAX_REQUEST_WORK`. Called after [`Analysis::validate`].
     ///
     /// # Errors
     /// As the analysis' validation.
@@ -162,7 +162,7 @@ pub use crate::report::present::Destination;
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
-/// probe ([`report::with_si`]).
+/// probe (`report::with_si`).
 ///
 /// # Errors
 /// As [`Analysis::execute`] and [`Analysis::report`]; [`SimError::Budget`] naming the request,
@@ -226,7 +226,7 @@ pub(crate) fn validate<A: Analysis + ?Sized>(
 }
 
 /// The document of `analysis`'s `output` on `model`: [`Analysis::report`] with the SI block of
-/// the probe ([`report::with_si`]) — [`run`]'s, and a front end's for a study it ran into a
+/// the probe (`report::with_si`) — [`run`]'s, and a front end's for a study it ran into a
 /// store of its own.
 ///
 /// # Errors

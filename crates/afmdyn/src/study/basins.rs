@@ -2,8 +2,8 @@
 //! row of one pass, numbered `pass × ny + iy`; its record the finished row ([`BasinRow`]: its
 //! cells and the attractors found there); what a resume skips the stored rows themselves, since
 //! each pass begins with the attractors and the coarse grid of the passes before it
-//! ([`run_passes`] merges the stored rows in their place, so a resumed map is the
-//! uninterrupted one). The map is assembled from the records by [`basin_map`], whatever store
+//! (`run_passes` merges the stored rows in their place, so a resumed map is the
+//! uninterrupted one). The map is assembled from the records by `basin_map`, whatever store
 //! kept them: `MemoryStore` for a run that writes no files, the
 //! directory store `basin_store` (feature `files`) for `afmdyn basins --out DIR`, resumable.
 //!
@@ -74,10 +74,10 @@ impl BasinStudy {
         row.pass * self.spec.ys.len() + row.iy
     }
 
-    /// The map of a finished study's records (in any order), as [`basin_map`].
+    /// The map of a finished study's records (in any order), as `basin_map`.
     ///
     /// # Errors
-    /// As [`basin_map`]: [`SimError::Cancelled`] when a row is missing.
+    /// As `basin_map`: [`SimError::Cancelled`] when a row is missing.
     pub fn map(&self, records: impl IntoIterator<Item = BasinRow>) -> Result<BasinMap, SimError> {
         basin_map(&self.spec, records.into_iter().collect())
     }

@@ -13,7 +13,7 @@
 //!   `chart_store`; a PI-scanned image's lines, `scan_store`), the checkpoint's CSV rows for
 //!   a sweep (`sweep::SweepRows`); and [`MemoryStore`], which keeps the tasks in memory
 //!   with the same ledger (a resume of the same request goes on, of another is refused). What
-//!   a resume skips is gathered from the stored records ([`Resumes`]).
+//!   a resume skips is gathered from the stored records (`Resumes`).
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   `crate::request::limits::check_threads`), runs the study, appends each finished task
@@ -22,7 +22,7 @@
 //!   library (Dask), each rebuilt from its recipe, with its ledger.
 //! - the studies: three kinds ([`Study`] implementations). `Tasks`: independent tasks
 //!   `0..n` run in parallel — [`chart`] (a behaviour chart's tiles, its store [`chart_store`]),
-//!   [`scan`] (a PI-scanned image's lines, its store `scan_store`) and [`peakforce_image`]
+//!   [`scan`] (a PI-scanned image's lines, its store `scan_store`) and `peakforce_image`
 //!   (a PeakForce image's lines). `Chain`: tasks that start from the records before them —
 //!   [`basins`] (a basin map's rows, pass by pass, its store `basins::basin_store`),
 //!   [`global_continuation`] (a global continuation's values, its store
@@ -49,7 +49,7 @@ pub(crate) mod image;
 mod kinds;
 mod memory;
 pub(crate) mod peakforce;
-pub mod peakforce_image;
+pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
 pub mod scan;
@@ -90,7 +90,7 @@ impl<R> Default for Prefix<R> {
 /// stored twice counts once, its first record): the tasks' numbers (`HashSet<usize>`: the
 /// records stay in the store), the records in the order of the tasks (`Vec<R>`), the first
 /// unbroken ones (`Prefix`), or a sweep's points with their chains' last states.
-pub trait Resumes<Record>: Sized {
+pub(crate) trait Resumes<Record>: Sized {
     /// What gathers the records.
     type Gathered: Default;
     /// Note one stored record.

@@ -21,7 +21,7 @@ impl PeakForceImageStudy {
 ///
 /// # Errors
 /// As [`PeakForceImageStudy::new`] and the lines; [`SimError::Cancelled`].
-pub fn peakforce_image(
+pub(crate) fn peakforce_image(
     probe_table: &toml::Table,
     map: &SampleMap,
     req: &ImageRequest,

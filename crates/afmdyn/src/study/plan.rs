@@ -6,7 +6,7 @@
 //! here ([`super::execute`]) bit for bit.
 //!
 //! - a bifurcation sweep: stage 0 the two coarse continuation passes, stage 1 the chain
-//!   segments and random starts seeded by them ([`SweepPlan`]); with a store, the command
+//!   segments and random starts seeded by them (`SweepPlan`); with a store, the command
 //!   line's resumable one ([`Plan::store`], [`PlanStore`]);
 //! - a basin map: one stage per pass, whose start is the attractors and coarse grid of the
 //!   passes before it (`pass_start`), one task per row;

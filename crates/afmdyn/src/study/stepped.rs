@@ -59,7 +59,10 @@ impl CurveStudy {
     /// # Errors
     /// As [`ApproachRequest::spec`] and `check_values`; [`SimError::Budget`] beyond the
     /// budgets of a request (`check_cost`).
-    pub fn approach(request: &ApproachRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
+    pub(crate) fn approach(
+        request: &ApproachRequest,
+        model: &Resolved,
+    ) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
             "approach",
             request.spec(model)?,
@@ -70,12 +73,9 @@ impl CurveStudy {
     /// The study of the resonance curve `request` on `model`.
     ///
     /// # Errors
-    /// As [`ResonanceRequest::spec`] and [`check_values`]; [`SimError::Budget`] beyond the
-    /// budgets of a request ([`check_cost`]).
-    pub(crate) fn resonance(
-        request: &ResonanceRequest,
-        model: &Resolved,
-    ) -> Result<CurveStudy, SimError> {
+    /// As [`ResonanceRequest::spec`] and `check_values`; [`SimError::Budget`] beyond the
+    /// budgets of a request (`check_cost`).
+    pub fn resonance(request: &ResonanceRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
             "resonance",
             request.spec(model)?,

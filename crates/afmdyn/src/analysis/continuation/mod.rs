@@ -6,7 +6,7 @@
 //! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
 //! ∂F/∂p from the parameter sensitivity along the same flow where the integrator provides it
-//! (the exact propagator for Ω, α2, α5: [`StroboscopicMap::with_param_derivative`]), else by central
+//! (the exact propagator for Ω, α2, α5: `StroboscopicMap::with_param_derivative`), else by central
 //! differences of the map, by flows without the variational equations. Test functions
 //! between accepted points: dp/ds (fold), det(M + I) (period doubling), the number of complex
 //! multipliers outside the unit circle (Neimark–Sacker) and the number of switchings per cycle
@@ -149,7 +149,7 @@ impl BranchEnd {
 
     /// A one-line warning for a branch that ended early, naming the parameter `param` at which
     /// it stopped, the `BranchEnd::cause` and what to change; `None` for a complete branch.
-    pub fn warning(&self, param: SweepParam, period: usize) -> Option<String> {
+    pub(crate) fn warning(&self, param: SweepParam, period: usize) -> Option<String> {
         let cause = self.cause()?;
         let p = param.name();
         let at = |x: f64| {

@@ -53,7 +53,7 @@ use std::sync::Mutex;
 /// `z_offset` (m).
 pub(crate) const Z_OFFSET: &str = "z_offset";
 /// `sample.youngs_modulus` (Pa).
-pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
+pub(crate) const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `sample.hamaker` (J).
 pub(crate) const HAMAKER: &str = "sample.hamaker";
 /// `tip.radius` (m).
@@ -76,7 +76,7 @@ pub(crate) const SENSITIVITY_TOLERANCE: f64 = 1e-9;
 
 /// A parameter of the dynamic fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AmParam {
+pub(crate) enum AmParam {
     /// `sample.youngs_modulus`.
     YoungsModulus,
     /// `sample.hamaker` (DMT).
@@ -114,7 +114,7 @@ impl AmParam {
         }
     }
     /// Its probe name.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             AmParam::YoungsModulus => YOUNGS_MODULUS,
             AmParam::Hamaker => HAMAKER,
@@ -134,18 +134,18 @@ impl AmParam {
 /// ∂y/∂p = Σ_o ∂y/∂o · ∂o/∂p. A parameter adds its terms in [`scaled`]; the orbit parameters
 /// a model differentiates are those the terms name ([`Chain::orbit_params`]).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Chain {
+pub(crate) struct Chain {
     /// (p, o, ∂o/∂p), in the order added.
     pub terms: Vec<(AmParam, OrbitParam, f64)>,
 }
 
 impl Chain {
     /// Add the term ∂o/∂p = `factor`.
-    pub fn push(&mut self, param: AmParam, orbit: OrbitParam, factor: f64) {
+    pub(crate) fn push(&mut self, param: AmParam, orbit: OrbitParam, factor: f64) {
         self.terms.push((param, orbit, factor));
     }
     /// The orbit parameters the terms name, each once, in the order first named.
-    pub fn orbit_params(&self) -> Vec<OrbitParam> {
+    pub(crate) fn orbit_params(&self) -> Vec<OrbitParam> {
         let mut v: Vec<OrbitParam> = Vec::new();
         for (_, o, _) in &self.terms {
             if !v.contains(o) {
@@ -168,7 +168,7 @@ impl Chain {
 
 /// The probe's SI values the model scales from.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AmProbe {
+pub(crate) struct AmProbe {
     /// The probe's dimensionless parameters (α4 at `youngs_modulus`, H̃ at `hamaker`).
     pub params: Params,
     /// g₀ (m per unit length).
@@ -200,7 +200,7 @@ impl AmProbe {
 
     /// The probe's viscosity η (Pa s) of DMT's or JKR's Kelvin–Voigt term, α6 over
     /// `AmProbe::viscosity_unit`; 0 under another law.
-    pub fn viscosity(&self) -> f64 {
+    pub(crate) fn viscosity(&self) -> f64 {
         match self.params.contact_law {
             ContactLaw::Dmt { .. } | ContactLaw::Jkr { .. } if self.radius > 0.0 => {
                 self.params.alpha6 / self.viscosity_unit(self.radius)
@@ -213,7 +213,7 @@ impl AmProbe {
     /// the force scale of its Hertz group, F_s = (4/3)E*√R g₀^{3/2}/α4
     /// (`crate::contact::SampleSi::hertz_alpha4`), so W = P̃ (4/3) E* g₀^{3/2}/(π α4 √R)
     /// (the probe's E*, R, g₀). 0 under another law (or α4 = 0).
-    pub fn adhesion_energy(&self) -> f64 {
+    pub(crate) fn adhesion_energy(&self) -> f64 {
         let ContactLaw::Jkr { adhesion } = self.params.contact_law else {
             return 0.0;
         };
@@ -234,7 +234,7 @@ impl AmProbe {
 
 /// The channels of a [`SteppedCurveModel`]: the AM curve's (amplitude, phase), the bimodal
 /// curve's (A₁, φ₁, A₂, φ₂) ([`super::bimodal_curve`]).
-pub trait Channels: Copy + std::fmt::Debug {
+pub(crate) trait Channels: Copy + std::fmt::Debug {
     /// The further drive component whose harmonic is A₂, φ₂ (`None`: the first harmonic alone).
     const COMPONENT: Option<usize>;
     /// Which of (A₁, φ₁, A₂, φ₂) are the values, in that order.
@@ -262,7 +262,7 @@ impl Channels for (bool, bool) {
 /// curve's ([`AmCurveModel`]) or the bimodal channels'
 /// ([`super::bimodal_curve::BimodalCurveModel`]).
 #[derive(Debug)]
-pub struct SteppedCurveModel<C> {
+pub(crate) struct SteppedCurveModel<C> {
     /// The probe (for the bimodal channels, its drive with a second component).
     pub probe: AmProbe,
     /// The piezo positions z (m) of the rows, in the order the instrument stepped.
@@ -281,12 +281,12 @@ pub struct SteppedCurveModel<C> {
 }
 
 /// The model of a measured AM curve (module docs).
-pub type AmCurveModel = SteppedCurveModel<(bool, bool)>;
+pub(crate) type AmCurveModel = SteppedCurveModel<(bool, bool)>;
 
 impl<C: Channels> SteppedCurveModel<C> {
     /// A model of the rows `z` (m) under `probe`, with parameters `params` and the channels
     /// (amplitude, phase; or A₁, φ₁, A₂, φ₂).
-    pub fn new(probe: AmProbe, z: Vec<f64>, channels: C, params: Vec<AmParam>) -> Self {
+    pub(crate) fn new(probe: AmProbe, z: Vec<f64>, channels: C, params: Vec<AmParam>) -> Self {
         let mut spec = SteppedSpec::new(probe.params, SweepParam::Alpha5, Vec::new());
         spec.branches = false;
         let tolerance = SENSITIVITY_TOLERANCE;
@@ -302,7 +302,7 @@ impl<C: Channels> SteppedCurveModel<C> {
     }
 
     /// The last evaluation's warnings (folds, grazing, rows off a period-1 orbit).
-    pub fn warnings(&self) -> Vec<String> {
+    pub(crate) fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
 }
@@ -319,7 +319,7 @@ pub(crate) fn gaps(probe: &AmProbe, q: &Params, z: &[f64], z_offset: f64) -> Vec
 /// The model's parameters of `probe` with `params` at `p` (SI, in the order of `params`; the
 /// others at the probe's values), z_offset (m), and the chain rule from the model's groups to
 /// the fitted parameters (module docs).
-pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, Chain) {
+pub(crate) fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, Chain) {
     let pr = probe;
     let get = |a: AmParam, default: f64| {
         params

@@ -16,7 +16,7 @@ use super::am_curve::{AmParam, AmProbe, Channels, SteppedCurveModel};
 use crate::error::SimError;
 
 /// The model of a measured bimodal curve (module docs).
-pub type BimodalCurveModel = SteppedCurveModel<[bool; 4]>;
+pub(crate) type BimodalCurveModel = SteppedCurveModel<[bool; 4]>;
 
 /// (A₁, φ₁, A₂, φ₂), the second ones the harmonic of the drive's further component: under a
 /// probe whose drive has one.

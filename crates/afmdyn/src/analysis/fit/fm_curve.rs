@@ -39,7 +39,7 @@ use std::sync::Mutex;
 
 /// The model of a measured Δf curve (module docs).
 #[derive(Debug)]
-pub struct FmCurveModel {
+pub(crate) struct FmCurveModel {
     /// The probe (its free amplitude A₀ = 1 g₀ the amplitude setpoint).
     pub probe: AmProbe,
     /// The piezo positions z (m) of the rows, in the order the instrument stepped.
@@ -62,7 +62,12 @@ impl FmCurveModel {
     /// A model of the rows `z` (m) under `probe` (whose scales give `hz_per_omega`), with
     /// parameters `params`; setpoint A₀, the loop to `DEFAULT_LOOP_TOLERANCE`, the
     /// sensitivities to `SENSITIVITY_TOLERANCE`.
-    pub fn new(probe: AmProbe, z: Vec<f64>, params: Vec<AmParam>, hz_per_omega: f64) -> Self {
+    pub(crate) fn new(
+        probe: AmProbe,
+        z: Vec<f64>,
+        params: Vec<AmParam>,
+        hz_per_omega: f64,
+    ) -> Self {
         FmCurveModel {
             probe,
             z,
@@ -76,7 +81,7 @@ impl FmCurveModel {
     }
 
     /// The last evaluation's warnings (folds, grazing, rows not reached).
-    pub fn warnings(&self) -> Vec<String> {
+    pub(crate) fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
 

@@ -58,7 +58,7 @@ pub(crate) fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
 }
 
 /// `sample.youngs_modulus` (Pa).
-pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
+pub(crate) const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `tip.radius` (m).
 pub(crate) const RADIUS: &str = "tip.radius";
 /// `contact_point` (m): the tip position where δ = 0, after `correct_tip_offset`.
@@ -70,11 +70,11 @@ pub(crate) const HAMAKER: &str = "sample.hamaker";
 /// `sample.adhesion_energy` (J/m²), JKR's work of adhesion W.
 pub(crate) const ADHESION: &str = "sample.adhesion_energy";
 /// `sample.stiffness` (N/m): the SLS's relaxed spring k₁ ([`super::sls_curve`]).
-pub const STIFFNESS: &str = "sample.stiffness";
+pub(crate) const STIFFNESS: &str = "sample.stiffness";
 /// `sample.maxwell_stiffness` (N/m): the SLS Maxwell arm's spring k₂.
-pub const MAXWELL_STIFFNESS: &str = "sample.maxwell_stiffness";
+pub(crate) const MAXWELL_STIFFNESS: &str = "sample.maxwell_stiffness";
 /// `sample.relaxation_time` (s): the SLS Maxwell arm's τ = η/k₂.
-pub const RELAXATION_TIME: &str = "sample.relaxation_time";
+pub(crate) const RELAXATION_TIME: &str = "sample.relaxation_time";
 
 /// Which part of the curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,7 +84,7 @@ pub enum Segment {
     /// After it.
     Retract,
     /// Every row: approach, dwell and retract (a time-dependent law's history; JKR's
-    /// [`ForceCurveModel`] takes these rows as an approach's).
+    /// `ForceCurveModel` takes these rows as an approach's).
     Whole,
 }
 
@@ -136,7 +136,7 @@ pub(crate) fn deviation_from_baseline(force: &[f64]) -> Option<usize> {
 
 /// The preprocessing of the module docs on a curve of piezo heights `height` (m) and forces
 /// `force` (N) with the lever's spring constant `spring_constant` (N/m).
-pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Preprocessed {
+pub(crate) fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Preprocessed {
     let mut tip: Vec<f64> = height
         .iter()
         .zip(force)
@@ -178,7 +178,7 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
 /// The force-curve model at the rows' tip positions (module docs). Parameters in
 /// `parameter_names`' order.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ForceCurveModel {
+pub(crate) struct ForceCurveModel {
     /// The law (one `parameter_names` takes).
     pub law: LawKind,
     /// The tip positions x (m) of the fitted rows.

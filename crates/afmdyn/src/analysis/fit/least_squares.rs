@@ -29,13 +29,13 @@ pub(crate) const TOLERANCE: f64 = 1e-10;
 
 /// The minimiser's patience: it stops after `PATIENCE × (n + 1)` evaluations of the residuals
 /// (n free parameters; MINPACK's `maxfev`, the crate's `with_patience`).
-pub const PATIENCE: usize = 200;
+pub(crate) const PATIENCE: usize = 200;
 
 /// The most model evaluations of one minimisation over `n` free parameters with `patience`
 /// ([`PATIENCE`] for a fit): the minimiser's `patience` × (n + 1) residual evaluations, at
 /// most as many Jacobians (one per outer iteration, each of which evaluates the residuals at
 /// least once) and the final χ²; 1 with nothing free.
-pub fn max_evaluations(n: usize, patience: usize) -> usize {
+pub(crate) fn max_evaluations(n: usize, patience: usize) -> usize {
     match n {
         0 => 1,
         n => 2 * patience * (n + 1) + 1,
@@ -273,6 +273,7 @@ fn sum_squares(obs: &Observations, f: &[f64]) -> f64 {
 /// parameter's value; the fixed ones held at theirs), within the bounds.
 ///
 /// `params`, `start` and `fixed` have the model's n entries; `obs` its m points.
+#[cfg(test)]
 pub fn minimize(
     model: &dyn CurveModel,
     obs: &Observations,

@@ -6,7 +6,7 @@ use serde::Serialize;
 /// A model parameter whose sensitivity is taken (dimensionless, the model's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum OrbitParam {
+pub(crate) enum OrbitParam {
     /// α5, the gap: V_T = W + α2 sin Ωτ + α5 (eq. 8); a rest distance z_c moves it one to one.
     Gap,
     /// α4, the Hertz group of the Hertz and DMT laws (∝ E* √R).

@@ -34,12 +34,12 @@ const BISECTIONS: usize = 5;
 /// The most refits on each side of the secant walk of the dynamic fit: with the first step at
 /// one standard error and at most doubling, 6 refits reach 32 SE from the estimate before the
 /// profile is called flat.
-pub const MAX_SECANT_STEPS: usize = 6;
+pub(crate) const MAX_SECANT_STEPS: usize = 6;
 
 /// The secant walk ends at a refit whose Δχ² is within this of `DELTA_CHI2_95`: 3.841 ± 0.05,
 /// i.e. r = √Δχ² within 1.96 ± 0.013, the end within 0.65 % of the interval's half-width for a
 /// parabolic profile; the coverage of χ²₁ at 3.791 … 3.891 is 94.84 … 95.14 %.
-pub const SECANT_TOLERANCE: f64 = 0.05;
+pub(crate) const SECANT_TOLERANCE: f64 = 0.05;
 
 /// The relative tolerance of a profile's refits (MINPACK's ftol, xtol, gtol): χ² to 1e-7
 /// relative is Δχ² to 1e-4 at χ² = 1000 (m = 1000 points), far inside
@@ -51,7 +51,7 @@ pub(crate) const REFIT_TOLERANCE: f64 = 1e-7;
 /// neighbour's minimum and converges in a few iterations (~12 evaluations on the dynamic fit of
 /// scripts/perf-fit-dynamic.sh); the cap bounds the profiles' declared cost. A refit that meets
 /// it is counted ([`Profile::unconverged`]) and warned of.
-pub const REFIT_PATIENCE: usize = 50;
+pub(crate) const REFIT_PATIENCE: usize = 50;
 
 /// How a profile is walked (the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,11 +63,11 @@ pub enum ProfileWalk {
     /// The secant walk on √Δχ²: the first refit at one standard error, then the secant through
     /// the last two points (regula falsi once the crossing is bracketed, kept within the
     /// bracket's middle 96 %), each step at most doubling the distance from the estimate (where
-    /// Δχ² rises slowly); it ends at a refit within [`SECANT_TOLERANCE`] of the threshold, or
+    /// Δχ² rises slowly); it ends at a refit within `SECANT_TOLERANCE` of the threshold, or
     /// after `max_steps` refits a side (a flat profile, or the crossing interpolated in its
     /// bracket).
     Secant {
-        /// The most refits a side ([`MAX_SECANT_STEPS`] for the dynamic fit).
+        /// The most refits a side (`MAX_SECANT_STEPS` for the dynamic fit).
         max_steps: usize,
     },
 }
@@ -113,7 +113,7 @@ pub struct Profile {
     pub refits: usize,
     /// Model evaluations the refits made.
     pub evaluations: usize,
-    /// Refits that stopped at [`REFIT_PATIENCE`] before converging.
+    /// Refits that stopped at `REFIT_PATIENCE` before converging.
     pub unconverged: usize,
 }
 

@@ -6,7 +6,7 @@
 //! # Method
 //! The model's state z (2N) is extended by the two Fourier integrals of the tip deflection
 //! W(1,τ) = φᵀa against the drive, q_s' = W sin θ, q_c' = W cos θ (θ = Ωτ + ψ, ψ the drive's
-//! phase, [`crate::params::Params::drive_phase`]), and by the parameters p with p' = 0. The
+//! phase, `crate::params::Params::drive_phase`), and by the parameters p with p' = 0. The
 //! extended system's Jacobian has the parameter columns ∂f/∂p = (0, M⁻¹φ ∂F_c/∂p), with ∂F_c/∂p
 //! in closed form from the law (F_c the law's force at δ = −V_T, δ̇ = −V̇_T, `d_force`):
 //! * α5 enters through the gap, V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8), so ∂F_c/∂α5 =
@@ -29,7 +29,7 @@
 //!   adaptive integrator cannot pass the onset at 1e-12 (1000 rejected steps): it says so.
 //!
 //! # The drive
-//! The FM loop's unknowns ([`super::fm_curve`]) are the drive's α2 and Ω:
+//! The FM loop's unknowns (`super::fm_curve`) are the drive's α2 and Ω:
 //! * α2 enters the forcing b(τ) = b₀ + b_s sin Ωτ + b_c cos Ωτ linearly
 //!   (`CantileverModel::forcing_derivative`) and, on the base-driven beam, the tip force
 //!   through V_T = W + α2 sin Ωτ + α5 and V̇_T = W' + α2 Ω cos Ωτ (eq. 8), so its column is
@@ -66,7 +66,7 @@
 //! (the state's, α5's and α2's through ∂g/∂p, the others through S alone). The guard σV_T does
 //! not move with α6, α4 or H̃ (∂g/∂α6 = 0), so their columns take no w ∂g/∂p term of their
 //! own. The saltation is applied at every switching, as the monodromy matrix of
-//! [`crate::maps::flow`] applies it ([`crate::system::saltation_parts`], with f⁺ and f⁻ of
+//! [`crate::maps::flow`] applies it (`crate::system::saltation_parts`, with f⁺ and f⁻ of
 //! the extended system), so nothing more is needed for α6.
 //!
 //! By the implicit function theorem on the shooting equations P(z*, p) = z*,
@@ -77,8 +77,8 @@
 //!
 //! # Where it breaks
 //! At a fold, I − M is singular (a multiplier at +1) and ∂z*/∂p is unbounded; at grazing, the
-//! map is not differentiable. Both are reported as [`SensitivityWarning`]s, with their
-//! measures: the smallest singular value of I − M against [`fold_threshold`] ([`FOLD_TOL`], or
+//! map is not differentiable. Both are reported as `SensitivityWarning`s, with their
+//! measures: the smallest singular value of I − M against `fold_threshold` (`FOLD_TOL`, or
 //! less for a high-Q lever whose free multipliers lie near +1), and the grazing distance
 //! of the flow ([`crate::maps::flow::FlowMap::grazing_distance`]) against
 //! `crate::analysis::shooting::GRAZING_TOL`.
@@ -88,7 +88,7 @@
 //! α6 √δ δ̇) and `jkr` (below).
 //!
 //! # JKR
-//! The law `jkr` takes α5, α4, its adhesion group P̃ ([`OrbitParam::Adhesion`]) and its
+//! The law `jkr` takes α5, α4, its adhesion group P̃ (`OrbitParam::Adhesion`) and its
 //! Kelvin–Voigt group α6 (the damper α6 q² δ̇):
 //! its force at fixed δ moves through the root q(δ) of the contact radius, its contact guard
 //! |δ_b| − V_T moves with α4 and P̃, and its force jumps where the contact forms and breaks, so
@@ -108,11 +108,11 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 
-pub use super::orbit_param::OrbitParam;
+pub(crate) use super::orbit_param::OrbitParam;
 
 /// The smallest singular value of I − M below which an orbit counts as near a fold: there
 /// (I − M)⁻¹ amplifies by more than 10³ and the sensitivities lose three digits.
-pub const FOLD_TOL: f64 = 1e-3;
+pub(crate) const FOLD_TOL: f64 = 1e-3;
 
 /// The smallest singular value of I − M below which an orbit of `model` over `period` counts
 /// as near a fold: [`FOLD_TOL`], or a fifth of the free lever's own distance of a multiplier
@@ -120,7 +120,7 @@ pub const FOLD_TOL: f64 = 1e-3;
 /// ([`crate::eigen::damped_eigenvalues`]), when that is smaller. A lever driven at its
 /// resonance has multipliers e^{λT} within ~π/Q of +1 without any fold (the free oscillation's
 /// slow decay): at Q = 20 000, 1.6e-4, which [`FOLD_TOL`] alone would flag on every row.
-pub fn fold_threshold(model: &CantileverModel, period: f64) -> f64 {
+pub(crate) fn fold_threshold(model: &CantileverModel, period: f64) -> f64 {
     let free = crate::eigen::damped_eigenvalues(model.galerkin().region(Region::Free));
     let scale = free
         .iter()
@@ -137,7 +137,7 @@ pub fn fold_threshold(model: &CantileverModel, period: f64) -> f64 {
 /// Why a sensitivity is not to be trusted.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-pub enum SensitivityWarning {
+pub(crate) enum SensitivityWarning {
     /// I − M is near singular (a multiplier near +1: a fold of the branch).
     NearFold {
         /// The smallest singular value of I − M.
@@ -177,7 +177,7 @@ impl std::fmt::Display for SensitivityWarning {
 
 /// A period-1 orbit with its first harmonic and their exact parameter sensitivities.
 #[derive(Debug, Clone, PartialEq)]
-pub struct OrbitSensitivity {
+pub(crate) struct OrbitSensitivity {
     /// z* at τ = 0, shape `[2N]`.
     pub state: DVector<f64>,
     /// A₁ of the tip deflection (g₀), from the Fourier integrals of the extended flow.
@@ -563,7 +563,7 @@ impl TipSampleSystem for Extended {
 /// JKR, and for P̃ ([`OrbitParam::Adhesion`]) under another law;
 /// [`SimError::NoConvergence`] from the Newton solve; [`SimError::OutOfRange`] naming
 /// `component` when the drive has no such component; [`SimError`] from the integrator.
-pub fn orbit_sensitivity(
+pub(crate) fn orbit_sensitivity(
     model: &CantileverModel,
     tol: f64,
     guess: &DVector<f64>,

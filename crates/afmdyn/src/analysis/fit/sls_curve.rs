@@ -46,14 +46,14 @@
 
 use super::CurveModel;
 
-pub use super::force_curve::{MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS};
+pub(crate) use super::force_curve::{MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS};
 
 /// The parameters the SLS fit frees by default: its three, the contact point and the baseline.
 /// The baseline is freed because the preprocessing's force offset (the mean force before the
 /// contact found by `deviation_from_baseline`) takes in the rows of the contact's first rise
 /// below its threshold; held, that offset biased k₁ (the 95 % intervals covered k₁ in 86 of
 /// 100 draws at 200 pN noise, against 95 expected).
-pub const DEFAULT_FIT: [&str; 5] = [
+pub(crate) const DEFAULT_FIT: [&str; 5] = [
     STIFFNESS,
     MAXWELL_STIFFNESS,
     RELAXATION_TIME,
@@ -64,7 +64,7 @@ pub const DEFAULT_FIT: [&str; 5] = [
 /// The SLS force-curve model (module docs) over every row of a curve in time order, valued
 /// at the fitted rows. Parameters: k₁ (N/m), k₂ (N/m), τ (s), contact_point (m), baseline (N).
 #[derive(Debug, Clone, PartialEq)]
-pub struct SlsCurveModel {
+pub(crate) struct SlsCurveModel {
     /// The piezo height h (m) of every row in the preprocessed frame (x − F/k).
     pub height: Vec<f64>,
     /// The time (s) of every row, strictly increasing.
@@ -137,7 +137,7 @@ impl std::ops::Mul<Dual> for f64 {
 impl SlsCurveModel {
     /// The contact force F_c (N) of every row, and ∂F_c/∂(k₁, k₂, τ, contact_point) when
     /// `jacobian` is given (row-major, 4 per row).
-    pub fn forces(&self, p: &[f64], forces: &mut [f64], mut jacobian: Option<&mut [f64]>) {
+    pub(crate) fn forces(&self, p: &[f64], forces: &mut [f64], mut jacobian: Option<&mut [f64]>) {
         let (k1, k2, tau, cp) = (
             Dual::var(p[0], 0),
             Dual::var(p[1], 1),

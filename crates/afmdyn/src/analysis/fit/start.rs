@@ -1,4 +1,4 @@
-//! Start values for the minimiser ([`super::least_squares::minimize`]): a parameter started at
+//! Start values for the minimiser (`super::least_squares::minimize`): a parameter started at
 //! the least χ² of a grid, the others at their starts. Levenberg–Marquardt descends to the
 //! nearest minimum; where χ² has several (the dynamic fit's stepped approach, whose first rows
 //! follow another branch than the data's when the contact point is off), a coarse scan of the

@@ -9,7 +9,7 @@ use super::*;
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
-pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> {
+pub(crate) fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> {
     let h = model.free_tip_response()?;
     Ok(FreeResponse {
         amplitude: h.norm(),
@@ -22,7 +22,11 @@ pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> 
 ///
 /// # Errors
 /// As [`free_response`].
-pub fn closed_forms(model: &CantileverModel, a: f64, phase: f64) -> Result<ClosedForms, SimError> {
+pub(crate) fn closed_forms(
+    model: &CantileverModel,
+    a: f64,
+    phase: f64,
+) -> Result<ClosedForms, SimError> {
     let free = free_response(model)?;
     let m = EquivalentMode::of(model, 0);
     let (k, q) = (m.stiffness, m.quality_factor);

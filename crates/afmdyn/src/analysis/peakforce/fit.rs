@@ -17,7 +17,7 @@ use serde::Serialize;
 
 /// The default band of the fit: 30 % to 90 % of the force range from the adhesion to the
 /// peak force (afmdyn's choice; the band is an option of the request).
-pub(crate) const FIT_BAND: (f64, f64) = (0.3, 0.9);
+pub const FIT_BAND: (f64, f64) = (0.3, 0.9);
 
 /// Fewest retract points in the band for a fit.
 pub(crate) const MIN_FIT_POINTS: usize = 5;
@@ -42,7 +42,7 @@ pub struct DmtFit {
 /// (at or before) the peak force to (at or after) the pull-off, over the band (lo, hi) of
 /// fractions of the range [F_adh, F_peak] (module docs). `None` where fewer than
 /// `MIN_FIT_POINTS` (5) points fall in the band or the range is empty.
-pub(crate) fn fit_dmt(d: &[f64], f: &[f64], (lo, hi): (f64, f64)) -> Option<DmtFit> {
+pub fn fit_dmt(d: &[f64], f: &[f64], (lo, hi): (f64, f64)) -> Option<DmtFit> {
     let n = d.len().min(f.len());
     if n < MIN_FIT_POINTS {
         return None;

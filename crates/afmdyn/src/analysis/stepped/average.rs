@@ -6,7 +6,7 @@
 //! At each value the motion is integrated on from the previous value's end state (τ and z: the
 //! drive's components keep their phases, as in an instrument whose z_c moves), in windows of
 //! [`AverageOptions::window_periods`] primary drive periods 2π/Ω, each component demodulated
-//! over a Hann² window ([`observe_tapered`]), until two successive windows' phasors
+//! over a Hann² window (`observe_tapered`), until two successive windows' phasors
 //! A_i e^{iφ_i} differ by at most [`AverageOptions::tol`] of each free amplitude A₀ᵢ (or the
 //! point's transient cap, `transient_cap`, is spent: the point is then reported unsettled).
 //! The point's observables are then measured over one such window of
@@ -56,7 +56,7 @@ pub(crate) const MAX_DEFAULT_WINDOW: usize = 4096;
 /// 1/(q |r − p/q|) primary periods follow the beat instead of settling (at f₂ = 1761/281 f₁,
 /// 94/15: the beat is the common period, 281 periods). The slowest over the components as
 /// (p, q, r, its period in primary periods); `None` when every ratio is such a fraction.
-pub fn slowest_beat(p: &crate::params::Params) -> Option<(u32, u32, f64, f64)> {
+pub(crate) fn slowest_beat(p: &crate::params::Params) -> Option<(u32, u32, f64, f64)> {
     p.components()
         .filter_map(|c| {
             let r = c.ratio();
@@ -88,7 +88,7 @@ impl AverageOptions {
     /// f₂ = 6.27 f₁ the 6th harmonic of f₁ is 0.27 f₁ from f₂: 30 periods) — and at least
     /// half the slowest free mode's decay time 1/λ, so that the transient changes between
     /// windows by a sizeable factor (e^{−1/2}; at Q = 400, 64 periods), and at least four
-    /// periods of the slowest beat of the combination tones ([`slowest_beat`]), up to
+    /// periods of the slowest beat of the combination tones (`slowest_beat`), up to
     /// `MAX_DEFAULT_WINDOW` periods in all; four of them measured;
     /// tolerance 1e-5 (in contact the windows of a 40 N/m lever tapping polystyrene at
     /// f₂ = 6.27 f₁ still differ by 1e-6 of A₀ after 20 000 periods: combination tones of high

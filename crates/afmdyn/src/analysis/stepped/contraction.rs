@@ -15,7 +15,7 @@
 //! more periods (the geometric series of the differences still ahead: their sum, the
 //! transient left, is at most s_m/(1 − r^{m/D}), and each is r^{P/D} of the last after P
 //! periods). When no lag's P_m falls within what is left of the free decay's wait (ln(1/tol)
-//! Q/π periods at resonance, [`crate::analysis::steady::decay_periods`]) in [`STALLED_RUNS`]
+//! Q/π periods at resonance, `crate::analysis::steady::decay_periods`) in [`STALLED_RUNS`]
 //! successive runs, the period test cannot succeed before that wait ends, and the wait is
 //! over: the returns' differences have stopped contracting (the irregular taps and missed taps
 //! of a grazing JKR contact, whose returns stay ~1e-4 apart however long the motion runs) or
@@ -49,7 +49,7 @@ pub enum SettleWait {
     #[default]
     Contraction,
     /// Until the slowest free mode has decayed by the period test's tolerance
-    /// ([`crate::analysis::steady::decay_periods`]) whatever the returns do.
+    /// (`crate::analysis::steady::decay_periods`) whatever the returns do.
     FreeDecay,
 }
 

@@ -38,7 +38,7 @@ use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
 use crate::analysis::progress::Progress;
-pub(crate) use crate::analysis::settle::Found;
+pub use crate::analysis::settle::Found;
 use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
 use crate::analysis::shooting::{
     broyden_pays, shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,
@@ -98,7 +98,7 @@ pub const DEFAULT_CURVE_POINTS: usize = 120;
 /// # Errors
 /// [`SimError::OutOfRange`] for non-finite or equal ends, a step that is not finite and > 0,
 /// or more than [`MAX_CURVE_POINTS`] values.
-pub fn grid(from: f64, to: f64, spacing: Spacing) -> Result<Vec<f64>, SimError> {
+pub(crate) fn grid(from: f64, to: f64, spacing: Spacing) -> Result<Vec<f64>, SimError> {
     crate::error::finite("from", from)?;
     crate::error::finite("to", to)?;
     if from == to {

@@ -66,11 +66,11 @@ fn average_window(system: &dyn TipSampleSystem) -> usize {
 /// [`AVERAGE_MIN_WINDOW`] periods) of the stroboscopic
 /// returns' period test (`spec.steady`: a period-m orbit, polished by Newton; each run of
 /// returns at least 4 `max_period` + 2 periods, to confirm any period) alternating with
-/// windows of the motion's time average ([`observe_tapered`], the Hann² window), whichever
+/// windows of the motion's time average (`observe_tapered`, the Hann² window), whichever
 /// decides first: the motion is settled by its time average once [`AVERAGE_AGREEMENTS`]
 /// successive windows' phasors A e^{iφ} and mean deflections agree to [`AVERAGE_TOL`] of A (as
 /// the time average of a multifrequency drive settles, [`super::average`]), and not before
-/// the slowest free mode has decayed by the period test's tolerance ([`decay_periods`]: an
+/// the slowest free mode has decayed by the period test's tolerance (`decay_periods`: an
 /// orbit whose transient decays as fast has shown its period by then) — unless the returns'
 /// measured contraction ends that wait earlier (`spec.settle_wait`, [`SettleWait`]): in
 /// [`STALLED_RUNS`] successive runs no lag m ≤ `max_period` of the returns' differences

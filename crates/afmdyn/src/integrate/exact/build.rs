@@ -77,7 +77,10 @@ impl ExactPropagator {
     /// # Errors
     /// [`SimError::OutOfRange`] for Ω at an undamped resonance (see [`ExactPropagator::new`]);
     /// [`SimError::Unsupported`] for a law that is not affine (only the linear law is).
-    pub fn try_new(model: &CantileverModel, min_steps_per_period: usize) -> Result<Self, SimError> {
+    pub(crate) fn try_new(
+        model: &CantileverModel,
+        min_steps_per_period: usize,
+    ) -> Result<Self, SimError> {
         Self::try_with(
             model,
             ExactOptions {
@@ -90,7 +93,7 @@ impl ExactPropagator {
     /// Build with explicit [`ExactOptions`] (propagation path, reuse of earlier builds).
     ///
     /// # Errors
-    /// As [`ExactPropagator::try_new`]; [`SimError::Budget`] when the grid of one period would
+    /// As `ExactPropagator::try_new`; [`SimError::Budget`] when the grid of one period would
     /// exceed `crate::params::GRID_BUDGET_BYTES`.
     pub fn try_with(model: &CantileverModel, opts: ExactOptions) -> Result<Self, SimError> {
         if !model.law().is_affine() {

@@ -236,7 +236,7 @@ impl SweepTally {
 
     /// The warning of failed points, if any.
     #[cfg(feature = "files")]
-    pub fn warning(&self) -> Option<String> {
+    pub(crate) fn warning(&self) -> Option<String> {
         self.first_error.as_ref().map(|first| {
             format!(
                 "{} of {} sweep points failed; the first: {first}",
@@ -249,7 +249,7 @@ impl SweepTally {
     /// The summary line of `values` values of `param` (the front end adds where the outputs
     /// are).
     #[cfg(feature = "files")]
-    pub fn summary(&self, values: usize, param: SweepParam) -> String {
+    pub(crate) fn summary(&self, values: usize, param: SweepParam) -> String {
         format!(
             "{} values of {}: {} periodic, {} nonperiodic, {} failed points",
             values,

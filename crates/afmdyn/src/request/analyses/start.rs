@@ -188,7 +188,7 @@ impl StartRequest {
     ///
     /// # Errors
     /// As [`initial_state`], [`SteadyRequest::options`] and [`steady_state`].
-    pub fn guess(
+    pub(crate) fn guess(
         &self,
         model: &CantileverModel,
     ) -> Result<(DVector<f64>, Option<usize>), SimError> {

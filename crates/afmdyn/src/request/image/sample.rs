@@ -325,7 +325,7 @@ impl SampleMap {
 
     /// The true height at (x, y) (m): the top domain's height, risen over its `width` inside its
     /// edges (smoothstep), plus the height map's bilinear interpolation there.
-    pub fn height_at(&self, x: f64, y: f64) -> f64 {
+    pub(crate) fn height_at(&self, x: f64, y: f64) -> f64 {
         let domain = self.domain_at(x, y).map_or(0.0, |k| {
             let d = &self.domains[k];
             if d.width <= 0.0 {
@@ -379,7 +379,7 @@ impl SampleMap {
     }
 
     /// The domain at (x, y) (m): the last listed that contains it, `None` for the background.
-    pub fn domain_at(&self, x: f64, y: f64) -> Option<usize> {
+    pub(crate) fn domain_at(&self, x: f64, y: f64) -> Option<usize> {
         self.domains.iter().rposition(|d| {
             (d.x.0..=d.x.1).contains(&x) && d.y.is_none_or(|(y0, y1)| (y0..=y1).contains(&y))
         })

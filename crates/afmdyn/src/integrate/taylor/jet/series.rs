@@ -97,7 +97,7 @@ impl Series {
     }
 
     /// The guard's series: V_T in free flight, w in contact (both positive inside the region).
-    pub fn guard(&self) -> &[f64] {
+    pub(crate) fn guard(&self) -> &[f64] {
         match self.region {
             Region::Free => &self.v[..=self.p],
             Region::Contact => &self.w[..=self.p],
