@@ -2,7 +2,7 @@
 //! held against the budgets before any work ([`Analysis::cost`]: the materials' approach curves,
 //! the pixels' memory and a scan's drive periods), run (the ideal feedback's image and setpoint
 //! study, [`super::scan::pi_image`], [`super::peakforce_image::peakforce_image`]) and presented
-//! (`crate::request::present::image`).
+//! (`crate::report::present::image`).
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -98,10 +98,10 @@ impl Analysis for ImageJob {
         let setpoint = self.request.setpoint;
         Ok(match output {
             ImageOutput::Ideal { image, study } => {
-                crate::request::present::image::ideal_summary(image, setpoint, study.as_ref())
+                crate::report::present::image::ideal_summary(image, setpoint, study.as_ref())
             }
-            ImageOutput::Pi(img) => crate::request::present::image::pi_summary(img, setpoint),
-            ImageOutput::PeakForce(img) => crate::request::present::image::peakforce_summary(img),
+            ImageOutput::Pi(img) => crate::report::present::image::pi_summary(img, setpoint),
+            ImageOutput::PeakForce(img) => crate::report::present::image::peakforce_summary(img),
         })
     }
 
@@ -145,7 +145,7 @@ impl Analysis for ImageJob {
     ) -> Result<Presentation, SimError> {
         let setpoint = self.request.setpoint;
         Ok(match output {
-            ImageOutput::Ideal { image, study } => crate::request::present::image::ideal(
+            ImageOutput::Ideal { image, study } => crate::report::present::image::ideal(
                 image,
                 setpoint,
                 study.as_ref(),
@@ -153,10 +153,10 @@ impl Analysis for ImageJob {
                 units,
             ),
             ImageOutput::Pi(img) => {
-                crate::request::present::image::pi(img, setpoint, document, units)
+                crate::report::present::image::pi(img, setpoint, document, units)
             }
             ImageOutput::PeakForce(img) => {
-                crate::request::present::image::peakforce(img, document, units)
+                crate::report::present::image::peakforce(img, document, units)
             }
         })
     }
