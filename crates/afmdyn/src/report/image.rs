@@ -10,6 +10,21 @@ use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
+/// The `[line][pixel]` array of `f(line, pixel)` over a grid of `shape` (lines, pixels).
+fn grid(shape: (usize, usize), f: &dyn Fn(usize, usize) -> Value) -> Value {
+    let line = |j| Value::Array((0..shape.1).map(|i| f(j, i)).collect());
+    Value::Array((0..shape.0).map(line).collect())
+}
+
+/// `v` as a JSON number, `null` where it is not finite.
+fn finite(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
 /// Regime of an operating point (García & San Paulo 2000): the mean tip–sample force is
 /// attractive (negative) or repulsive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -140,32 +155,19 @@ impl Image {
     /// `setpoint`, `warnings`.
     pub fn document(&self, setpoint: f64) -> Value {
         let shape = (self.y.len(), self.x.len());
-        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
-            Value::Array(
-                (0..shape.0)
-                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
-                    .collect(),
-            )
-        };
-        let num = |v: f64| {
-            if v.is_finite() {
-                serde_json::json!(v)
-            } else {
-                Value::Null
-            }
-        };
         let mut image = columns::grids(&FIELDS, self, &columns::cells(shape), shape);
         image.insert("x".into(), serde_json::json!(self.x));
         image.insert("y".into(), serde_json::json!(self.y));
-        let regime = grid(&|j, i| {
+        let regime = grid(shape, &|j, i| {
             self.point(j, i)
                 .map_or(Value::Null, |o| serde_json::json!(o.regime))
         });
         image.insert("regime".into(), regime);
-        let material =
-            grid(&|j, i| serde_json::json!(self.materials[self.pixels[j][i].material].name));
+        let material = grid(shape, &|j, i| {
+            serde_json::json!(self.materials[self.pixels[j][i].material].name)
+        });
         image.insert("material".into(), material);
-        let domain = grid(&|j, i| {
+        let domain = grid(shape, &|j, i| {
             serde_json::json!(self.pixels[j][i]
                 .domain
                 .map_or("background", |k| { self.domain_names[k].as_str() }))
@@ -175,7 +177,7 @@ impl Image {
             "image": image,
             "feedback": "ideal",
             "setpoint": setpoint,
-            "reference_z_c": num(self.reference),
+            "reference_z_c": finite(self.reference),
             "materials": self.materials,
             "warnings": self.warnings,
         })
@@ -524,27 +526,22 @@ impl PeakForceImage {
     pub fn document(&self) -> Value {
         use serde_json::json;
         let shape = (self.y.len(), self.x.len());
-        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
-            Value::Array(
-                (0..shape.0)
-                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
-                    .collect(),
-            )
-        };
         let mut image = columns::grids(&PF_FIELDS, self, &columns::cells(shape), shape);
         image.insert("x".into(), json!(self.x));
         image.insert("y".into(), json!(self.y));
         image.insert(
             "evaluations".into(),
-            grid(&|j, i| json!(self.pixels[j][i].evaluations)),
+            grid(shape, &|j, i| json!(self.pixels[j][i].evaluations)),
         );
         image.insert(
             "material".into(),
-            grid(&|j, i| json!(self.materials[self.material[j][i]].name)),
+            grid(shape, &|j, i| {
+                json!(self.materials[self.material[j][i]].name)
+            }),
         );
         image.insert(
             "domain".into(),
-            grid(&|j, i| {
+            grid(shape, &|j, i| {
                 json!(self.domain[j][i].map_or("background", |k| self.domain_names[k].as_str()))
             }),
         );
@@ -558,15 +555,14 @@ impl PeakForceImage {
     /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
     pub(crate) fn document_head(&self) -> Value {
         use serde_json::json;
-        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
         json!({
             "mode": "peakforce",
             "feedback": "ideal",
             "setpoint": self.setpoint,
-            "reference_z_c": num(self.reference),
+            "reference_z_c": finite(self.reference),
             "materials": self.materials.iter().map(|m| json!({
                 "name": m.name,
-                "true_modulus": num(m.true_modulus),
+                "true_modulus": finite(m.true_modulus),
                 "engaged": m.engaged,
                 "message": m.message,
                 "evaluations": m.evaluations,
