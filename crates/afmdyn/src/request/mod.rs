@@ -89,8 +89,8 @@ pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
 pub(crate) use pool::in_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
-    admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document, Resolved,
-    ResonanceRequest,
+    admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document,
+    Presenting, Resolved, ResonanceRequest,
 };
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a

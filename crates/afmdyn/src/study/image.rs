@@ -6,7 +6,7 @@
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::report::{Presentation, TextUnits};
+use crate::report::Presentation;
 use crate::request::image::{background_probe, curves_cost, image, setpoint_study};
 use crate::request::image_job::{ImageJob, ImageMode, ImageOutput};
 use crate::request::image_peakforce::{peakforce_cost, peakforce_probe};
@@ -137,11 +137,8 @@ impl Analysis for ImageJob {
 
     fn present(
         &self,
-        _model: &Resolved,
         output: &ImageOutput,
-        document: &Value,
-        units: TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<Presentation, SimError> {
         let setpoint = self.request.setpoint;
         Ok(match output {
@@ -149,14 +146,14 @@ impl Analysis for ImageJob {
                 image,
                 setpoint,
                 study.as_ref(),
-                document,
-                units,
+                at.document,
+                at.units,
             ),
             ImageOutput::Pi(img) => {
-                crate::report::present::image::pi(img, setpoint, document, units)
+                crate::report::present::image::pi(img, setpoint, at.document, at.units)
             }
             ImageOutput::PeakForce(img) => {
-                crate::report::present::image::peakforce(img, document, units)
+                crate::report::present::image::peakforce(img, at.document, at.units)
             }
         })
     }
