@@ -14,7 +14,7 @@ use crate::progress;
 use afmdyn::layout::files::{write_bytes, write_csv, NpyStream};
 use afmdyn::report::present::Files;
 use afmdyn::report::{OutputFile, Presentation};
-use afmdyn::request::{Analysis, Destination, Document, Resolved};
+use afmdyn::request::{Analysis, Destination, Document, Presenting, Resolved};
 use afmdyn::study::stored::{Resumable, Storage};
 use serde_json::Value;
 use std::path::Path;
@@ -135,7 +135,13 @@ fn present<A: Analysis>(
         dforce_columns: exit.dforce_columns,
     };
     let units = units_of(model.probe.as_ref());
-    let mut shown = request.present(model, output, document, units, to)?;
+    let at = Presenting {
+        model,
+        document,
+        units,
+        to,
+    };
+    let mut shown = request.present(output, at)?;
     to.keep(&mut shown);
     Ok(shown)
 }

@@ -503,7 +503,7 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
         time_constant: Some(20e-6),
     };
     let lib = pi_image(&table, &map, &req, &scan, Some(1), &Progress::new()).unwrap();
-    let lib = afmdyn::request::present::image::pi_summary(&lib, 0.5);
+    let lib = afmdyn::report::present::image::pi_summary(&lib, 0.5);
     assert_eq!(doc, lib);
     summarises(&doc["image"], &dir.path().join("out").join("image.nc"));
     assert_eq!(doc["feedback"], "pi");

@@ -1,7 +1,7 @@
 //! `run("image", input)`: the AM-AFM image of a heterogeneous sample under an ideal amplitude
 //! feedback: its document with every pixel ([`afmdyn::request::image::Image::document`], which
 //! the explorer draws), of which `afmdyn image --probe P --sample S --setpoint R --json` prints
-//! the summary ([`afmdyn::request::present::image::ideal_summary`]; the maps in `image.nc`).
+//! the summary ([`afmdyn::report::present::image::ideal_summary`]; the maps in `image.nc`).
 //!
 //! The input: `probe` (a probe file's text: the lever, tip, drive and the background sample;
 //! required), `sample` (a sample map's text, [`afmdyn::request::image::SampleMap::parse`]:

@@ -253,19 +253,18 @@ fn a_frequency_shift_csv_goes_through_the_fit_door() {
     // residual, and the two frequency-shift figures (not the force curve's)
     {
         use afmdyn::report::{OutputFile, TextUnits};
-        use afmdyn::request::Analysis;
-        let shown = request
-            .present(
-                &resolved,
-                &done.output,
-                &doc,
-                TextUnits {
-                    scales: Some(p.scales),
-                    plain: false,
-                },
-                Default::default(),
-            )
-            .expect("present");
+        use afmdyn::request::{Analysis, Presenting};
+        let units = TextUnits {
+            scales: Some(p.scales),
+            plain: false,
+        };
+        let at = Presenting {
+            model: &resolved,
+            document: &doc,
+            units,
+            to: Default::default(),
+        };
+        let shown = request.present(&done.output, at).expect("present");
         let mut names = Vec::new();
         for f in &shown.files {
             match f {

@@ -3,7 +3,7 @@
 //! file ([`netcdf`], feature `files`), the Python `xarray.Dataset` and the Dask Zarr store.
 //!
 //! The layouts of the results are declared beside them (a chart's, a basin map's, a sweep's);
-//! the ideal-feedback image's is `crate::request::image_layout`.
+//! the ideal-feedback image's is `crate::report::image_layout`.
 //!
 //! Values are row-major over the variable's dimensions (the last one fastest), as NetCDF,
 //! NumPy and xarray store them.

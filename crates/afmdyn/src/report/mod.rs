@@ -389,6 +389,8 @@ pub(crate) mod curve_layout;
 mod curve_table;
 mod curves;
 mod documents;
+pub mod image;
+pub(crate) mod image_layout;
 pub mod present;
 mod series;
 #[cfg(feature = "files")]

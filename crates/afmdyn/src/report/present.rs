@@ -5,9 +5,6 @@
 //! store (`chart`, `image`, the stepped curves, `bifurcation`) or streams a run to files, and
 //! the commands without a computation of their own (`modes --sweep fig3`, `units`,
 //! `cantilevers`) call theirs directly.
-//!
-//! The presentations of the images, the maps (`chart`, `basins`) and the bifurcation sweep
-//! still read request types and stay in `crate::request::present` until those types move.
 
 #[cfg(feature = "files")]
 pub(crate) mod census;
@@ -19,6 +16,7 @@ pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fit;
 pub mod fm;
+pub mod image;
 pub(crate) mod maps;
 pub(crate) mod modes;
 pub(crate) mod orbits;

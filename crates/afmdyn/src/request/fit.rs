@@ -620,15 +620,16 @@ impl Analysis for FitRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
         _: &FitResult,
-        document: &Value,
-        units: crate::report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
+        let mut document = at.document.clone();
         let to = crate::report::present::Destination::default();
-        Ok(crate::report::present::fit::fit(&mut document, units, to))
+        Ok(crate::report::present::fit::fit(
+            &mut document,
+            at.units,
+            to,
+        ))
     }
 }
 

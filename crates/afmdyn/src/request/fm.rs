@@ -264,15 +264,12 @@ impl Analysis for FmRequest {
     }
     fn present(
         &self,
-        model: &Resolved,
         curve: &FmCurve,
-        document: &Value,
-        units: crate::report::TextUnits,
-        to: super::run::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
-        let table = table(model, curve);
-        let mut shown = crate::report::present::fm::fm(&mut document, table, units, to);
+        let mut document = at.document.clone();
+        let table = table(at.model, curve);
+        let mut shown = crate::report::present::fm::fm(&mut document, table, at.units, at.to);
         shown.document = Some(document);
         Ok(shown)
     }

@@ -37,7 +37,6 @@ use crate::analysis::approach::approach_retract;
 use crate::analysis::setpoint::operating_points;
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
-use crate::layout::columns::{self, columns, Column};
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
@@ -50,7 +49,10 @@ use super::limits::Cost;
 
 mod sample;
 mod study;
-pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy, MAX_STUDY_RATIOS};
+pub use study::{setpoint_study, study_ratios, MAX_STUDY_RATIOS};
+
+pub use crate::report::image::{DomainContrast, SetpointStudy};
+pub use crate::report::image::{Image, Material, OperatingPoint, Pixel, Regime};
 
 pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
@@ -164,116 +166,6 @@ impl ImageRequest {
             .unwrap_or(if map.size.1 == 0.0 { 1 } else { self.pixels })
     }
 }
-
-/// Regime of an operating point (García & San Paulo 2000): the mean tip–sample force is
-/// attractive (negative) or repulsive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Regime {
-    /// Net attractive force.
-    Attractive,
-    /// Net repulsive force.
-    Repulsive,
-}
-
-/// One operating point of a material at the setpoint, in SI: the rest distance and the
-/// observables interpolated there (`crate::report::setpoint`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct OperatingPoint {
-    /// `approach` or `retract`: the sweep it lies on.
-    pub source: String,
-    /// Rest distance z_c (m).
-    pub z_c: f64,
-    /// Regime.
-    pub regime: Regime,
-    /// Amplitude (m).
-    pub amplitude: f64,
-    /// Phase lag (degrees).
-    pub phase_deg: f64,
-    /// Energy dissipated per drive period (J).
-    pub energy_dissipated: f64,
-    /// Virial (J).
-    pub virial: f64,
-    /// Peak force (N).
-    pub peak_force: f64,
-    /// Indentation (m).
-    pub indentation: f64,
-}
-
-/// A material of the image: the background or a domain's sample, with its operating points.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Material {
-    /// `background` or the domain's name.
-    pub name: String,
-    /// Its operating points at the setpoint (none: the setpoint is not reached on it).
-    pub points: Vec<OperatingPoint>,
-    /// The warnings of its approach curve.
-    pub warnings: Vec<String>,
-}
-
-/// A pixel: its domain, material and operating point (`None`: the setpoint is not reached
-/// there).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pixel {
-    /// Index into the map's domains, `None` for the background.
-    pub domain: Option<usize>,
-    /// Index into [`Image::materials`].
-    pub material: usize,
-    /// True height (m).
-    pub height: f64,
-    /// Index into the material's points.
-    pub point: Option<usize>,
-    /// Whether the regime changed at this pixel because the material had no operating point
-    /// in the previous one.
-    pub switched: bool,
-}
-
-/// An ideal-feedback image ([`image`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Image {
-    /// Pixel centres x (m).
-    pub x: Vec<f64>,
-    /// Line positions y (m).
-    pub y: Vec<f64>,
-    /// The materials: 0 the background, then one per domain with its own sample.
-    pub materials: Vec<Material>,
-    /// The pixels, `[line][pixel]`.
-    pub pixels: Vec<Vec<Pixel>>,
-    /// z_c,ref (m): the engaged rest distance on the background, the zero of the apparent
-    /// height.
-    pub reference: f64,
-    /// The map's domain names, in its order.
-    pub domain_names: Vec<String>,
-    /// What the image cannot show as asked.
-    pub warnings: Vec<String>,
-}
-
-/// A pixel of an image: (line, pixel).
-pub(crate) type Cell = (usize, usize);
-
-/// The numeric maps of an image over (y, x), in SI (NaN, `null` in the document, where the
-/// setpoint is not reached): the document's `image` block ([`Image::document`]) and the
-/// variables of its layout (`image.nc`, Python's Dataset), in this order.
-pub(crate) const FIELDS: [Column<Image, Cell>; 9] = columns! {
-    "height", Length, false, "apparent height h + z_c − z_c,ref (ideal feedback)",
-        F64(|g, &(j, i)| g.apparent_height(j, i));
-    "true_height", Length, false, "true height of the sample map",
-        F64(|g, &(j, i)| g.pixels[j][i].height);
-    "z_c", Length, false, "rest distance z_c the feedback holds",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.z_c));
-    "amplitude", Length, false, "amplitude (the setpoint where reached)",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.amplitude));
-    "phase_deg", Fixed("degree"), false, "phase lag behind the drive",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.phase_deg));
-    "energy_dissipated", Energy, false, "energy dissipated per drive period",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.energy_dissipated));
-    "virial", Energy, false, "virial of the tip–sample force",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.virial));
-    "peak_force", Force, false, "largest tip–sample force",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.peak_force));
-    "indentation", Length, false, "largest indentation",
-        Opt(|g, &(j, i)| Some(g.point(j, i)?.indentation));
-};
 
 impl ImageRequest {
     /// Check the request against the map.
@@ -691,66 +583,4 @@ pub(crate) fn image_of(
         domain_names: map.domains.iter().map(|d| d.name.clone()).collect(),
         warnings,
     })
-}
-
-impl Image {
-    /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
-    pub fn point(&self, line: usize, pixel: usize) -> Option<&OperatingPoint> {
-        let p = &self.pixels[line][pixel];
-        p.point.map(|i| &self.materials[p.material].points[i])
-    }
-
-    /// Apparent height of a pixel (m): h + z_c − z_c,ref (NaN where not reached).
-    pub(crate) fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
-        let p = &self.pixels[line][pixel];
-        self.point(line, pixel)
-            .map_or(f64::NAN, |o| p.height + o.z_c - self.reference)
-    }
-
-    /// The image document (`afmdyn image --json`): `image` with `x`, `y` (m) and per
-    /// `[line][pixel]` the `FIELDS` (null where not reached), `regime`, `material` and
-    /// `domain` (their names); `materials` with their operating points; `reference_z_c` (m),
-    /// `setpoint`, `warnings`.
-    pub fn document(&self, setpoint: f64) -> Value {
-        let shape = (self.y.len(), self.x.len());
-        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
-            Value::Array(
-                (0..shape.0)
-                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
-                    .collect(),
-            )
-        };
-        let num = |v: f64| {
-            if v.is_finite() {
-                serde_json::json!(v)
-            } else {
-                Value::Null
-            }
-        };
-        let mut image = columns::grids(&FIELDS, self, &columns::cells(shape), shape);
-        image.insert("x".into(), serde_json::json!(self.x));
-        image.insert("y".into(), serde_json::json!(self.y));
-        let regime = grid(&|j, i| {
-            self.point(j, i)
-                .map_or(Value::Null, |o| serde_json::json!(o.regime))
-        });
-        image.insert("regime".into(), regime);
-        let material =
-            grid(&|j, i| serde_json::json!(self.materials[self.pixels[j][i].material].name));
-        image.insert("material".into(), material);
-        let domain = grid(&|j, i| {
-            serde_json::json!(self.pixels[j][i]
-                .domain
-                .map_or("background", |k| { self.domain_names[k].as_str() }))
-        });
-        image.insert("domain".into(), domain);
-        serde_json::json!({
-            "image": image,
-            "feedback": "ideal",
-            "setpoint": setpoint,
-            "reference_z_c": num(self.reference),
-            "materials": self.materials,
-            "warnings": self.warnings,
-        })
-    }
 }

@@ -179,10 +179,10 @@ impl ImageKeywords {
 impl ImageOutput {
     /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
     /// `image.nc`'s variables, `super::image_layout`) and, as the fact `summary`, the
-    /// command line's `image.json` ([`crate::request::present::image`]).
+    /// command line's `image.json` ([`crate::report::present::image`]).
     pub fn outcome(&self, setpoint: f64) -> Outcome {
-        use super::image_layout::{layout, peakforce_layout, scan_layout};
-        use crate::request::present::image::{ideal_summary, peakforce_summary, pi_summary};
+        use crate::report::image_layout::{layout, peakforce_layout, scan_layout};
+        use crate::report::present::image::{ideal_summary, peakforce_summary, pi_summary};
         let (document, layout, summary) = match self {
             ImageOutput::Ideal { image, study } => (
                 image.document(setpoint),

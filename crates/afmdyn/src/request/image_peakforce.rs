@@ -34,7 +34,7 @@
 //! does not depend on the thread count or the executor.
 
 use super::costs::{newton_work, steady_periods, MODEL_BYTES};
-use super::image::{background_probe, material_models, pixel_grid, Cell, ImageRequest, SampleMap};
+use super::image::{background_probe, material_models, pixel_grid, ImageRequest, SampleMap};
 use super::limits::Cost;
 use super::peakforce::modulus_scale;
 use super::run::Resolved;
@@ -43,14 +43,14 @@ use crate::analysis::peakforce::{
     SteadyTap, BRACKET_STEPS, SETPOINT_ITERATIONS, SETPOINT_TOL,
 };
 use crate::error::SimError;
-use crate::layout::columns::{self, columns, Column};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::probe::Probe;
 use crate::report::CurveUnits;
 use nalgebra::DVector;
-use serde::{Deserialize, Serialize};
 use serde_json::Value;
+
+pub use crate::report::image::{LinePixel, PeakForceImage, PeakForceTap, PfMaterialReport};
 
 /// Most taps of the secant continuation at a change of material before the pixel is
 /// re-engaged from far.
@@ -59,41 +59,6 @@ pub(crate) const CONTINUE_ITERATIONS: usize = 30;
 /// Taps a change of material is expected to cost (the request's cost estimate): one, from the
 /// material's engaged orbit (module docs).
 pub(crate) const TAPS_PER_CHANGE: f64 = 1.0;
-
-/// A pixel's operating point in SI: the steady tap at the setpoint and its channels.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PeakForceTap {
-    /// Mean rest separation z_c the feedback holds (m).
-    pub z_c: f64,
-    /// Peak force (N): the setpoint to the feedback's tolerance.
-    pub peak_force: f64,
-    /// Adhesion, the most negative force (N, ≤ 0).
-    pub adhesion: f64,
-    /// Deformation, the largest indentation (m).
-    pub deformation: f64,
-    /// Tip–sample dissipation per modulation period (J).
-    pub dissipation: f64,
-    /// The DMT fit's reduced modulus E* (Pa; NaN where no fit or no tip radius).
-    pub modulus_dmt: f64,
-    /// Contacts per modulation period (1: a single tap; more: double taps).
-    pub taps_per_cycle: f64,
-    /// Modulation periods after which the orbit repeats (2: period-2 tapping).
-    pub period: usize,
-    /// Whether the orbit is stable (every Floquet multiplier inside the unit circle).
-    pub stable: bool,
-}
-
-/// One pixel of a line as its task computes it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LinePixel {
-    /// The operating point (`None`: the setpoint is not reached on the pixel's material).
-    pub tap: Option<PeakForceTap>,
-    /// Steady taps computed for this pixel (0 where the previous pixel's orbit is kept or the
-    /// material's engage is taken).
-    pub evaluations: usize,
-    /// Whether the continuation failed here and the pixel was re-engaged from far.
-    pub reengaged: bool,
-}
 
 /// A material of a PeakForce image and its engage.
 #[derive(Debug, Clone)]
@@ -493,49 +458,6 @@ fn si_tap(
     }
 }
 
-/// A material of a [`PeakForceImage`] as its document reports it (SI).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PfMaterialReport {
-    /// `background` or the domain's name.
-    pub name: String,
-    /// The sample's true reduced modulus E* (Pa; NaN without a tip radius).
-    pub true_modulus: f64,
-    /// The operating point a line engages on from far (`None`: the setpoint is not reached).
-    pub engaged: Option<PeakForceTap>,
-    /// Why the setpoint is not reached (`None` when it is).
-    pub message: Option<String>,
-    /// Steady taps of its engage's search.
-    pub evaluations: usize,
-}
-
-/// A PeakForce image ([module docs](self)).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PeakForceImage {
-    /// Pixel centres x (m).
-    pub x: Vec<f64>,
-    /// Line positions y (m).
-    pub y: Vec<f64>,
-    /// The setpoint: the peak force the feedback holds (N).
-    pub setpoint: f64,
-    /// The materials: 0 the background, then one per domain with its own sample.
-    pub materials: Vec<PfMaterialReport>,
-    /// The pixels' material (index into `materials`), `[line][pixel]`.
-    pub material: Vec<Vec<usize>>,
-    /// The pixels' domain (`None` the background), `[line][pixel]`.
-    pub domain: Vec<Vec<Option<usize>>>,
-    /// The true height (m), `[line][pixel]`.
-    pub true_height: Vec<Vec<f64>>,
-    /// The pixels, `[line][pixel]`.
-    pub pixels: Vec<Vec<LinePixel>>,
-    /// z_c,ref (m): the background's engaged z_c, the zero of the apparent height (NaN where
-    /// the background does not reach the setpoint).
-    pub reference: f64,
-    /// The map's domain names, in its order.
-    pub domain_names: Vec<String>,
-    /// What the image cannot show as asked.
-    pub warnings: Vec<String>,
-}
-
 impl PeakForceImageStudy {
     /// The image of the lines' records (any order).
     ///
@@ -619,114 +541,5 @@ impl PeakForceImageStudy {
             x,
             y,
         })
-    }
-}
-
-/// The numeric maps of a PeakForce image over (y, x), in SI (NaN, `null` in the document,
-/// where the setpoint is not reached): its document's `image` block and the variables of
-/// `image.nc`, in this order.
-pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
-    "height", Length, false, "apparent height h + z_c − z_c,ref (ideal peak-force feedback)",
-        Opt(|g, &(j, i)| Some(g.true_height[j][i] + g.tap(j, i)?.z_c - g.reference));
-    "true_height", Length, false, "true height of the sample map",
-        F64(|g, &(j, i)| g.true_height[j][i]);
-    "z_c", Length, false, "mean rest separation z_c the feedback holds",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.z_c));
-    "peak_force", Force, false, "peak force (the setpoint where reached)",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.peak_force));
-    "modulus_dmt", Fixed("Pa"), false, "reduced modulus E* of the DMT fit of the retract curve (PF-QNM)",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.modulus_dmt));
-    "adhesion", Force, false, "adhesion: the most negative tip–sample force",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.adhesion));
-    "deformation", Length, false, "deformation: the largest indentation",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.deformation));
-    "dissipation", Energy, false, "tip–sample dissipation per modulation period",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.dissipation));
-    "taps_per_cycle", Fixed("1"), false, "contacts per modulation period",
-        Opt(|g, &(j, i)| Some(g.tap(j, i)?.taps_per_cycle));
-};
-
-impl PeakForceImage {
-    /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
-    pub(crate) fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
-        self.pixels[line][pixel].tap.as_ref()
-    }
-
-    /// The value of the map `name` (`PF_FIELDS`) at (line, pixel) (NaN where not reached or
-    /// an unknown name).
-    pub fn value(&self, name: &str, line: usize, pixel: usize) -> f64 {
-        let field = PF_FIELDS.iter().find(|c| c.name == name);
-        field.map_or(f64::NAN, |c| c.number(self, &(line, pixel)))
-    }
-
-    /// The image document (`afmdyn image --mode peakforce --json`): `image` with `x`, `y` (m)
-    /// and per `[line][pixel]` the `PF_FIELDS` (SI; null where not reached), `evaluations`,
-    /// `material` and `domain` (names); `mode` `"peakforce"`, `feedback` `"ideal"`, `setpoint`
-    /// (N), `reference_z_c` (m), `materials` (each with its true modulus and engaged operating
-    /// point), `taps` (steady taps computed), `warnings`.
-    pub fn document(&self) -> Value {
-        use serde_json::json;
-        let shape = (self.y.len(), self.x.len());
-        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
-            Value::Array(
-                (0..shape.0)
-                    .map(|j| Value::Array((0..shape.1).map(|i| f(j, i)).collect()))
-                    .collect(),
-            )
-        };
-        let mut image = columns::grids(&PF_FIELDS, self, &columns::cells(shape), shape);
-        image.insert("x".into(), json!(self.x));
-        image.insert("y".into(), json!(self.y));
-        image.insert(
-            "evaluations".into(),
-            grid(&|j, i| json!(self.pixels[j][i].evaluations)),
-        );
-        image.insert(
-            "material".into(),
-            grid(&|j, i| json!(self.materials[self.material[j][i]].name)),
-        );
-        image.insert(
-            "domain".into(),
-            grid(&|j, i| {
-                json!(self.domain[j][i].map_or("background", |k| self.domain_names[k].as_str()))
-            }),
-        );
-        let mut doc = self.document_head();
-        doc["image"] = Value::Object(image);
-        doc
-    }
-
-    /// The document's keys other than `image` ([`PeakForceImage::document`]): `mode`,
-    /// `feedback`, `setpoint` (N), `reference_z_c` (m), `materials` (name, true modulus, the
-    /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
-    pub(crate) fn document_head(&self) -> Value {
-        use serde_json::json;
-        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
-        json!({
-            "mode": "peakforce",
-            "feedback": "ideal",
-            "setpoint": self.setpoint,
-            "reference_z_c": num(self.reference),
-            "materials": self.materials.iter().map(|m| json!({
-                "name": m.name,
-                "true_modulus": num(m.true_modulus),
-                "engaged": m.engaged,
-                "message": m.message,
-                "evaluations": m.evaluations,
-            })).collect::<Vec<_>>(),
-            "taps": self.taps(),
-            "warnings": self.warnings,
-        })
-    }
-
-    /// Steady taps computed for the image: the materials' engages and the lines' continuations.
-    pub(crate) fn taps(&self) -> usize {
-        self.materials.iter().map(|m| m.evaluations).sum::<usize>()
-            + self
-                .pixels
-                .iter()
-                .flatten()
-                .map(|p| p.evaluations)
-                .sum::<usize>()
     }
 }

@@ -35,18 +35,18 @@
 
 use super::image::{image_of, material_curves, Image, ImageRequest, SampleMap};
 use crate::analysis::am_loop::{
-    engage_position, scan_line, Engage, FeedbackGains, LineSpec, ScanLine, ScanPixel,
-    LOCK_IN_SAMPLES,
+    engage_position, scan_line, Engage, FeedbackGains, LineSpec, ScanLine, LOCK_IN_SAMPLES,
 };
 use crate::analysis::approach::rest_distance;
 use crate::error::{number, SimError};
 use crate::integrate::IntegratorOptions;
-use crate::layout::columns::{self, columns, Column};
 use crate::probe::Probe;
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
+
+pub use crate::report::image::{Artefacts, PiImage, ScanSettings};
 
 /// Most drive periods a scan may integrate (lines × (engage + 2 × pixels × periods per pixel)).
 pub(crate) const MAX_SCAN_PERIODS: u64 = 1_000_000_000;
@@ -79,66 +79,6 @@ pub struct PiScan {
     /// section `feedback`; [`crate::probe::ranges`]); outside 1 µs–0.1 s the image warns of a
     /// likely unit slip. `None`: τ_c/4.
     pub time_constant: Option<f64>,
-}
-
-/// The settings a scan ran with (SI), as its document reports them.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ScanSettings {
-    /// Scan rate (Hz).
-    pub scan_rate: f64,
-    /// K_P (dimensionless).
-    pub proportional_gain: f64,
-    /// K_I (1/s).
-    pub integral_gain: f64,
-    /// Lock-in time constant (s).
-    pub time_constant: f64,
-    /// Drive periods per pixel.
-    pub periods_per_pixel: usize,
-    /// Drive periods of each line's engage.
-    pub engage_periods: usize,
-    /// Lock-in samples per drive period.
-    pub lock_in_samples: usize,
-    /// Duration of a pixel (s).
-    pub pixel_time: f64,
-    /// τ_c = 2Q/ω₀ (s): the lever's amplitude time constant.
-    pub amplitude_time: f64,
-}
-
-/// One direction's artefacts ([module docs](self)).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Artefacts {
-    /// RMS of recorded − ideal height over the pixels where both exist (m).
-    pub height_rms_error: f64,
-    /// Largest |recorded − ideal height| (m).
-    pub height_max_error: f64,
-    /// Largest overshoot beyond the ideal heights of a pixel and its neighbours (m).
-    pub overshoot: f64,
-    /// RMS of the error image A_sp − A (m).
-    pub tracking_error_rms: f64,
-    /// Pixels that lost contact.
-    pub lost_contact_pixels: usize,
-    /// Drive periods at the controller's output limit.
-    pub saturated_periods: usize,
-    /// The largest per-mode energy-balance residual of a pixel's last period, relative to the
-    /// drive's work ([`ScanPixel::energy_residual`]).
-    pub energy_residual_max: f64,
-}
-
-/// A scanned image: the ideal image of the same map, the lines, the settings.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PiImage {
-    /// The ideal-feedback image (its materials, reference and geometry).
-    pub ideal: Image,
-    /// The lines in order.
-    pub lines: Vec<ScanLine>,
-    /// The settings.
-    pub settings: ScanSettings,
-    /// SI factors.
-    units: CurveUnits,
-    /// [trace, retrace].
-    pub artefacts: [Artefacts; 2],
-    /// The ideal image's warnings and the scan's.
-    pub warnings: Vec<String>,
 }
 
 /// What rebuilds a [`ScanStudy`] in any process (a Dask worker): the probe's table, the
@@ -547,163 +487,5 @@ fn empty_artefacts() -> Artefacts {
         lost_contact_pixels: 0,
         saturated_periods: 0,
         energy_residual_max: f64::NAN,
-    }
-}
-
-/// A pixel of a PI scan: (direction: 0 the trace, 1 the retrace; line; pixel).
-pub(crate) type ScanCell = (usize, usize, usize);
-
-/// The recorded maps of a PI scan over (y, x) in SI, each direction's: the document's `image`
-/// and `retrace` blocks ([`PiImage::document`]) and the variables of its layout (the
-/// retrace's suffixed `_retrace`), in this order.
-pub(crate) const SCAN_FIELDS: [Column<PiImage, ScanCell>; 9] = columns! {
-    "height", Length, false,
-        "recorded height: the mean piezo position less the ideal reference z_c,ref",
-        F64(|g, &(d, j, i)| g.height(d, j, i));
-    "amplitude", Length, false, "mean lock-in amplitude",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].amplitude * g.units.length);
-    "phase_deg", Fixed("degree"), false, "mean lock-in phase lag behind the drive",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].phase.to_degrees());
-    "tracking_error", Length, false, "mean amplitude error A_sp − A (the error image)",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].tracking_error * g.units.length);
-    "energy_dissipated", Energy, false, "energy dissipated over the pixel's last drive period",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].energy_dissipated * g.units.energy);
-    "virial", Energy, false, "virial over the pixel's last drive period",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].virial * g.units.energy);
-    "peak_force", Force, false, "largest tip–sample force over the pixel's last drive period",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].peak_force * g.units.force);
-    "indentation", Length, false, "largest indentation over the pixel's last drive period",
-        F64(|g, &(d, j, i)| g.row(d, j)[i].indentation * g.units.length);
-    "lost_contact", Fixed("1"), false,
-        "the controller lost contact (parachuting) in the pixel's last drive period",
-        Bool(|g, &(d, j, i)| g.row(d, j)[i].lost_contact);
-};
-
-/// The cells of direction `d` of a scan of `shape` (lines, pixels), line by line.
-pub(crate) fn scan_cells(d: usize, shape: (usize, usize)) -> Vec<ScanCell> {
-    let cells = crate::layout::columns::cells(shape).into_iter();
-    cells.map(|(j, i)| (d, j, i)).collect()
-}
-
-impl PiImage {
-    /// Metres per model length unit g₀ (the records' lengths).
-    pub(crate) fn length(&self) -> f64 {
-        self.units.length
-    }
-
-    /// Newtons per model force unit (the records' forces).
-    pub fn force(&self) -> f64 {
-        self.units.force
-    }
-
-    /// Joules per model energy unit (the records' energies).
-    pub fn energy(&self) -> f64 {
-        self.units.energy
-    }
-
-    /// The pixels of direction `d` (0 trace, 1 retrace) of line `j`.
-    fn row(&self, d: usize, j: usize) -> &[ScanPixel] {
-        if d == 0 {
-            &self.lines[j].trace
-        } else {
-            &self.lines[j].retrace
-        }
-    }
-
-    /// Recorded height (m) of pixel (j, i) in direction `d`: the mean piezo position less the
-    /// ideal image's reference.
-    pub(crate) fn height(&self, d: usize, j: usize, i: usize) -> f64 {
-        self.row(d, j)[i].z * self.units.length - self.ideal.reference
-    }
-
-    fn artefacts_of(&self, d: usize) -> Artefacts {
-        let (mut sq, mut n, mut worst, mut over, mut err_sq, mut lost, mut sat) =
-            (0.0, 0usize, 0.0f64, 0.0f64, 0.0, 0, 0);
-        let mut residual = 0.0f64;
-        let px = self.ideal.x.len();
-        for j in 0..self.lines.len() {
-            for i in 0..px {
-                let p = &self.row(d, j)[i];
-                let e = p.tracking_error * self.units.length;
-                err_sq += e * e;
-                lost += usize::from(p.lost_contact);
-                sat += p.saturated;
-                residual = residual.max(p.energy_residual);
-                let h = self.height(d, j, i);
-                let ideal = self.ideal.apparent_height(j, i);
-                if !ideal.is_finite() {
-                    continue;
-                }
-                sq += (h - ideal).powi(2);
-                n += 1;
-                worst = worst.max((h - ideal).abs());
-                // the ideal heights around it (a neighbour without one: no overshoot measured)
-                let around: Vec<f64> = (i.saturating_sub(1)..(i + 2).min(px))
-                    .map(|k| self.ideal.apparent_height(j, k))
-                    .collect();
-                if around.iter().all(|v| v.is_finite()) {
-                    let hi = around.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                    let lo = around.iter().copied().fold(f64::INFINITY, f64::min);
-                    over = over.max(h - hi).max(lo - h);
-                }
-            }
-        }
-        let all = (self.lines.len() * px) as f64;
-        Artefacts {
-            height_rms_error: if n > 0 {
-                (sq / n as f64).sqrt()
-            } else {
-                f64::NAN
-            },
-            height_max_error: if n > 0 { worst } else { f64::NAN },
-            overshoot: if n > 0 { over } else { f64::NAN },
-            tracking_error_rms: (err_sq / all).sqrt(),
-            lost_contact_pixels: lost,
-            saturated_periods: sat,
-            energy_residual_max: residual,
-        }
-    }
-
-    /// The image document of `afmdyn image --feedback pi --json` (SI): `image` with `x`, `y`
-    /// (m) and per `[line][pixel]` the trace's `height` (m, recorded: the mean piezo position
-    /// less the ideal reference), `ideal_height` (m, the ideal image's apparent height),
-    /// `true_height` (m), `amplitude` (m), `phase_deg`, `tracking_error` (m, A_sp − A),
-    /// `energy_dissipated` (J), `virial` (J), `peak_force` (N), `indentation` (m), `regime`,
-    /// `lost_contact`, `material` and `domain`; `retrace` with the same recorded fields;
-    /// `scan` (the [`ScanSettings`]), `artefacts` (`trace`, `retrace`: [`Artefacts`]),
-    /// `materials`, `reference_z_c` (m), `setpoint`, `warnings`.
-    pub fn document(&self, setpoint: f64) -> Value {
-        let ideal = self.ideal.document(setpoint);
-        let (ny, nx) = (self.lines.len(), self.ideal.x.len());
-        let grid = |d: usize, f: &dyn Fn(&ScanPixel) -> Value| -> Value {
-            let line = |j| Value::Array(self.row(d, j).iter().take(nx).map(f).collect());
-            Value::Array((0..ny).map(line).collect())
-        };
-        let recorded = |d: usize| {
-            let mut m = columns::grids(&SCAN_FIELDS, self, &scan_cells(d, (ny, nx)), (ny, nx));
-            let regime = grid(d, &|p| json!(crate::report::regime(p.mean_deflection)));
-            m.insert("regime".into(), regime);
-            let material = grid(d, &|p| json!(self.ideal.materials[p.material].name));
-            m.insert("material".into(), material);
-            m
-        };
-        let mut image = recorded(0);
-        let m = &mut image;
-        m.insert("x".into(), json!(self.ideal.x));
-        m.insert("y".into(), json!(self.ideal.y));
-        m.insert("ideal_height".into(), ideal["image"]["height"].clone());
-        m.insert("true_height".into(), ideal["image"]["true_height"].clone());
-        m.insert("domain".into(), ideal["image"]["domain"].clone());
-        m.insert("retrace".into(), Value::Object(recorded(1)));
-        json!({
-            "image": image,
-            "feedback": "pi",
-            "scan": self.settings,
-            "artefacts": {"trace": self.artefacts[0], "retrace": self.artefacts[1]},
-            "setpoint": setpoint,
-            "reference_z_c": ideal["reference_z_c"],
-            "materials": ideal["materials"],
-            "warnings": self.warnings,
-        })
     }
 }

@@ -49,7 +49,6 @@ pub(crate) mod fit_dynamic;
 pub(crate) mod fit_result;
 pub mod image;
 pub mod image_job;
-pub(crate) mod image_layout;
 pub mod image_options;
 pub mod image_peakforce;
 pub mod image_scan;
@@ -62,7 +61,6 @@ pub mod named;
 pub mod peakforce;
 pub(crate) mod peakforce_sweep;
 pub(crate) mod pool;
-pub mod present;
 
 pub mod reconstruct;
 pub(crate) mod reconstruct_document;
@@ -91,8 +89,8 @@ pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
 pub(crate) use pool::in_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
-    admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document, Resolved,
-    ResonanceRequest,
+    admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document,
+    Presenting, Resolved, ResonanceRequest,
 };
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a

@@ -47,17 +47,14 @@ impl Analysis for ModesRequest {
     }
     fn present(
         &self,
-        model: &Resolved,
         (free, contact): &Self::Output,
-        _: &Value,
-        units: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(crate::report::present::modes::modes(
-            &model.params,
+            &at.model.params,
             free,
             contact,
-            units,
+            at.units,
         ))
     }
 }
@@ -96,17 +93,14 @@ impl Analysis for Fig3Request {
     }
     fn present(
         &self,
-        model: &Resolved,
         points: &Self::Output,
-        _: &Value,
-        _: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         #[cfg(feature = "files")]
-        let mut shown = crate::report::present::modes::fig3(model.params.modes, points);
+        let mut shown = crate::report::present::modes::fig3(at.model.params.modes, points);
         #[cfg(not(feature = "files"))]
         let mut shown = report::Presentation::default();
-        let _ = model;
+        let _ = at.model;
         shown.summary = vec![format!("wrote {} points to", points.len())];
         shown.outputs_note = report::OutputsNote::Named;
         Ok(shown)
@@ -156,17 +150,16 @@ impl Analysis for UnitsRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
         output: &Self::Output,
-        document: &Value,
-        _: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(match (&self.physical, output) {
             (Some(m), Some((p, s))) => crate::report::present::modes::units(m, p, s),
             _ => {
                 let mut shown = report::Presentation::default();
-                shown.line(serde_json::to_string_pretty(document).expect("a document serialises"));
+                shown.line(
+                    serde_json::to_string_pretty(at.document).expect("a document serialises"),
+                );
                 shown
             }
         })
@@ -197,11 +190,8 @@ impl Analysis for CantileversRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
         _: &(),
-        _: &Value,
-        _: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        _: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(crate::report::present::modes::cantilevers())
     }

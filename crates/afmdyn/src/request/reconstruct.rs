@@ -337,17 +337,14 @@ impl Analysis for ReconstructRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
         r: &Reconstruction,
-        document: &Value,
-        units: crate::report::TextUnits,
-        to: super::run::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let how = match self.inversion {
             FmInversion::SaderJarvis => Inversion::SaderJarvis,
             FmInversion::Exact => Inversion::Exact,
         };
-        present_reconstruction(r, how, self.law_in_order(), document, units, to)
+        present_reconstruction(r, how, self.law_in_order(), at.document, at.units, at.to)
     }
 }
 
@@ -398,13 +395,10 @@ impl Analysis for AmReconstruction {
     }
     fn present(
         &self,
-        _: &Resolved,
         r: &Reconstruction,
-        document: &Value,
-        units: crate::report::TextUnits,
-        to: super::run::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        present_reconstruction(r, Inversion::AmMatrix, None, document, units, to)
+        present_reconstruction(r, Inversion::AmMatrix, None, at.document, at.units, at.to)
     }
 }
 

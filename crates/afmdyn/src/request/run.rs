@@ -138,9 +138,9 @@ pub trait Analysis {
         None
     }
     /// What the result shows besides its document ([`report::Presentation`]): the text
-    /// summary in `units`, its tables, datasets and figures as data, for every front end to
-    /// write to `to` (a front end keeps only the files `to.files` says: [`Destination::keep`]);
-    /// `document` is the result's JSON ([`run`]'s). A result whose files or document name the
+    /// summary in the [`Presenting`] units, its tables, datasets and figures as data, for every
+    /// front end to write where it says (a front end keeps only the files `to.files` says:
+    /// [`Destination::keep`]). A result whose files or document name the
     /// directory (`"csv"`: its path) adds them here, the document as printed in
     /// [`report::Presentation::document`]. Empty by default.
     ///
@@ -148,17 +148,27 @@ pub trait Analysis {
     /// [`SimError`] where the presentation needs the model built again (an invalid `params`).
     fn present(
         &self,
-        _model: &Resolved,
         _output: &Self::Output,
-        _document: &Value,
-        _units: report::TextUnits,
-        _to: Destination<'_>,
+        _: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(report::Presentation::default())
     }
 }
 
 pub use crate::report::present::Destination;
+
+/// What a result is presented with ([`Analysis::present`]), besides the result itself.
+#[derive(Clone, Copy)]
+pub struct Presenting<'a> {
+    /// The model the result was computed on.
+    pub model: &'a Resolved,
+    /// The result's JSON ([`run`]'s).
+    pub document: &'a Value,
+    /// The units of the text summary.
+    pub units: report::TextUnits,
+    /// Where a front end writes the result's files.
+    pub to: Destination<'a>,
+}
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
@@ -279,13 +289,10 @@ impl Analysis for OrbitRequest {
     }
     fn present(
         &self,
-        model: &Resolved,
         output: &Self::Output,
-        _: &Value,
-        units: report::TextUnits,
-        _: Destination<'_>,
+        at: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
-        crate::report::present::orbits::orbit(&model.params, output, units)
+        crate::report::present::orbits::orbit(&at.model.params, output, at.units)
     }
 }
 
@@ -325,18 +332,15 @@ impl Analysis for ContinuationRequest {
     #[cfg(feature = "files")]
     fn present(
         &self,
-        model: &Resolved,
         branches: &Self::Output,
-        _: &Value,
-        units: report::TextUnits,
-        _: Destination<'_>,
+        at: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         crate::report::present::continuation::continuation(
-            &model.params,
+            &at.model.params,
             self.param,
             self.from,
             branches,
-            units,
+            at.units,
         )
     }
 }
@@ -371,16 +375,13 @@ impl Analysis for LyapunovRequest {
     }
     fn present(
         &self,
-        model: &Resolved,
         output: &Self::Output,
-        _: &Value,
-        units: report::TextUnits,
-        _: Destination<'_>,
+        at: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(crate::report::present::orbits::lyapunov(
-            &model.params,
+            &at.model.params,
             output,
-            units,
+            at.units,
         ))
     }
 }
@@ -406,14 +407,12 @@ impl Analysis for AttractorsRequest {
     #[cfg(feature = "files")]
     fn present(
         &self,
-        model: &Resolved,
         r: &Self::Output,
-        document: &Value,
-        units: report::TextUnits,
-        _: Destination<'_>,
+        at: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
-        let spec = self.spec(&model.params)?;
-        let mut shown = crate::report::present::census::attractors(&spec, r, document, units)?;
+        let spec = self.spec(&at.model.params)?;
+        let mut shown =
+            crate::report::present::census::attractors(&spec, r, at.document, at.units)?;
         shown
             .warnings
             .extend(crate::report::present::census::failed_starts(
@@ -478,16 +477,13 @@ impl Analysis for ConvergeRequest {
     #[cfg(feature = "files")]
     fn present(
         &self,
-        model: &Resolved,
         runs: &Self::Output,
-        document: &Value,
-        _: report::TextUnits,
-        to: Destination<'_>,
+        at: Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
-        let mut shown = crate::report::present::converge::converge(&model.params, runs);
+        let mut shown = crate::report::present::converge::converge(&at.model.params, runs);
         // the printed document names the output directory
-        if let Some(dir) = to.dir {
-            let mut document = document.clone();
+        if let Some(dir) = at.to.dir {
+            let mut document = at.document.clone();
             document["out"] = serde_json::json!(dir);
             shown.document = Some(document);
         }

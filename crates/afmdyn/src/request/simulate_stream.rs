@@ -202,13 +202,10 @@ impl Analysis for SimulateStream {
     }
     fn present(
         &self,
-        model: &Resolved,
         r: &Self::Output,
-        _: &Value,
-        _: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
-        simulate(self, model, r)
+        simulate(self, at.model, r)
     }
 }
 

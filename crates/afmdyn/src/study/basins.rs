@@ -119,18 +119,15 @@ impl Analysis for BasinsRequest {
     }
     fn present(
         &self,
-        model: &Resolved,
         map: &BasinMap,
-        document: &Value,
-        _: crate::report::TextUnits,
-        to: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let spec = self.spec(&model.params)?;
-        let Some(dir) = to.dir else {
-            return crate::report::present::maps::basins(&spec, map, document);
+        let spec = self.spec(&at.model.params)?;
+        let Some(dir) = at.to.dir else {
+            return crate::report::present::maps::basins(&spec, map, at.document);
         };
         // the document (basins.json too) names the files written
-        let mut document = document.clone();
+        let mut document = at.document.clone();
         document["csv"] = serde_json::json!(dir.join("basins.csv"));
         document["netcdf"] = serde_json::json!(dir.join("basins.nc"));
         let mut shown = crate::report::present::maps::basins(&spec, map, &document)?;

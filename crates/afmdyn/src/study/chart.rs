@@ -56,16 +56,13 @@ impl Analysis for Chart {
     }
     fn present(
         &self,
-        _: &Resolved,
         cells: &Vec<ChartCell>,
-        document: &Value,
-        _: crate::report::TextUnits,
-        to: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut shown = crate::report::present::maps::chart(&self.view(), cells);
         // the printed document names the files written
-        if let Some(dir) = to.dir {
-            let mut document = document.clone();
+        if let Some(dir) = at.to.dir {
+            let mut document = at.document.clone();
             document["files"] = serde_json::json!({
                 "csv": dir.join("chart.csv"),
                 "netcdf": dir.join("chart.nc"),

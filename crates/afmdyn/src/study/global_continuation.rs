@@ -127,16 +127,13 @@ impl Analysis for GlobalContinuationRequest {
     #[cfg(feature = "files")]
     fn present(
         &self,
-        _: &Resolved,
         steps: &Self::Output,
-        document: &Value,
-        _: report::TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(crate::report::present::census::global_continuation(
             (self.param, self.samples),
             steps,
-            document,
+            at.document,
         ))
     }
 }

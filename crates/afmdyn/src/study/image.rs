@@ -2,11 +2,11 @@
 //! held against the budgets before any work ([`Analysis::cost`]: the materials' approach curves,
 //! the pixels' memory and a scan's drive periods), run (the ideal feedback's image and setpoint
 //! study, [`super::scan::pi_image`], [`super::peakforce_image::peakforce_image`]) and presented
-//! (`crate::request::present::image`).
+//! (`crate::report::present::image`).
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::report::{Presentation, TextUnits};
+use crate::report::Presentation;
 use crate::request::image::{background_probe, curves_cost, image, setpoint_study};
 use crate::request::image_job::{ImageJob, ImageMode, ImageOutput};
 use crate::request::image_peakforce::{peakforce_cost, peakforce_probe};
@@ -98,10 +98,10 @@ impl Analysis for ImageJob {
         let setpoint = self.request.setpoint;
         Ok(match output {
             ImageOutput::Ideal { image, study } => {
-                crate::request::present::image::ideal_summary(image, setpoint, study.as_ref())
+                crate::report::present::image::ideal_summary(image, setpoint, study.as_ref())
             }
-            ImageOutput::Pi(img) => crate::request::present::image::pi_summary(img, setpoint),
-            ImageOutput::PeakForce(img) => crate::request::present::image::peakforce_summary(img),
+            ImageOutput::Pi(img) => crate::report::present::image::pi_summary(img, setpoint),
+            ImageOutput::PeakForce(img) => crate::report::present::image::peakforce_summary(img),
         })
     }
 
@@ -137,26 +137,23 @@ impl Analysis for ImageJob {
 
     fn present(
         &self,
-        _model: &Resolved,
         output: &ImageOutput,
-        document: &Value,
-        units: TextUnits,
-        _: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<Presentation, SimError> {
         let setpoint = self.request.setpoint;
         Ok(match output {
-            ImageOutput::Ideal { image, study } => crate::request::present::image::ideal(
+            ImageOutput::Ideal { image, study } => crate::report::present::image::ideal(
                 image,
                 setpoint,
                 study.as_ref(),
-                document,
-                units,
+                at.document,
+                at.units,
             ),
             ImageOutput::Pi(img) => {
-                crate::request::present::image::pi(img, setpoint, document, units)
+                crate::report::present::image::pi(img, setpoint, at.document, at.units)
             }
             ImageOutput::PeakForce(img) => {
-                crate::request::present::image::peakforce(img, document, units)
+                crate::report::present::image::peakforce(img, at.document, at.units)
             }
         })
     }

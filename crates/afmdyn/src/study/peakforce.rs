@@ -212,15 +212,12 @@ impl Analysis for PeakForceRequest {
     }
     fn present(
         &self,
-        _: &Resolved,
         _: &PeakForceResult,
-        document: &Value,
-        units: crate::report::TextUnits,
-        to: crate::request::Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
+        let mut document = at.document.clone();
         let p = crate::report::present::peakforce::peakforce;
-        Ok(p(&mut document, units, to))
+        Ok(p(&mut document, at.units, at.to))
     }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
         // a sweep's largest over its taps

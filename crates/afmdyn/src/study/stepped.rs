@@ -25,9 +25,7 @@ use crate::report;
 use crate::report::present::curves::{stepped, CurveKind};
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
-use crate::request::run::{
-    Analysis, ApproachRequest, Bimodal, Destination, Resolved, ResonanceRequest,
-};
+use crate::request::run::{Analysis, ApproachRequest, Bimodal, Resolved, ResonanceRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -143,19 +141,16 @@ macro_rules! present_curve {
     ($kind:expr) => {
         fn present(
             &self,
-            model: &Resolved,
             c: &Self::Output,
-            document: &Value,
-            units: report::TextUnits,
-            to: Destination<'_>,
+            at: crate::request::Presenting<'_>,
         ) -> Result<report::Presentation, SimError> {
             Ok(stepped(
                 $kind,
-                (&model.params, model.probe.as_ref()),
+                (&at.model.params, at.model.probe.as_ref()),
                 c,
-                document,
-                units,
-                &to.curve(self.name()),
+                at.document,
+                at.units,
+                &at.to.curve(self.name()),
             ))
         }
     };
@@ -330,19 +325,16 @@ impl Analysis for Bimodal {
     }
     fn present(
         &self,
-        model: &Resolved,
         c: &Self::Output,
-        document: &serde_json::Value,
-        units: crate::report::TextUnits,
-        to: Destination<'_>,
+        at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        let options = to.curve("bimodal");
+        let options = at.to.curve("bimodal");
         Ok(stepped(
             CurveKind::Approach,
-            (&model.params, model.probe.as_ref()),
+            (&at.model.params, at.model.probe.as_ref()),
             c,
-            document,
-            units,
+            at.document,
+            at.units,
             &options,
         ))
     }

@@ -336,11 +336,8 @@ impl Analysis for SweepInto {
     }
     fn present(
         &self,
-        _: &Resolved,
         files: &SweepFiles,
-        _: &Value,
-        _: crate::report::TextUnits,
-        _: crate::request::Destination<'_>,
+        _: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         Ok(stored_bifurcation(files, self.0.param))
     }

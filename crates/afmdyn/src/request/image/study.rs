@@ -9,37 +9,6 @@ use crate::request::named::Outcome;
 /// the background that crosses every domain.
 pub const MAX_STUDY_RATIOS: usize = 1000;
 
-/// The apparent height and phase of every domain against the setpoint (issue 46's setpoint
-/// study: the contrast inversion of AM-AFM, García & San Paulo 2000): at each ratio a line
-/// engaged on the background ([`image`]'s rule) crosses onto each domain, whose operating point
-/// is the one the regime rule takes there. The materials' approach curves are computed once
-/// for all ratios.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SetpointStudy {
-    /// The setpoint ratios A_sp/A₀.
-    pub ratio: Vec<f64>,
-    /// The background first, then every domain of the map.
-    pub domains: Vec<DomainContrast>,
-    /// The materials' approach curves' warnings, named by material.
-    pub warnings: Vec<String>,
-}
-
-/// One domain's series of a [`SetpointStudy`]: per ratio its apparent height (m), phase lag
-/// (degrees) and regime, `None`/NaN where its material has no operating point there.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct DomainContrast {
-    /// `background` or the domain's name.
-    pub name: String,
-    /// Apparent height h + z_c − z_c,ref (m).
-    pub apparent_height: Vec<f64>,
-    /// Phase lag (degrees).
-    pub phase_deg: Vec<f64>,
-    /// Energy dissipated per period (J).
-    pub energy_dissipated: Vec<f64>,
-    /// Regime.
-    pub regime: Vec<Option<Regime>>,
-}
-
 /// The variables of a setpoint study's layout over (`domain`, `setpoint`)
 /// ([`SetpointStudy::layout`]): name, unit (SI) and long name.
 const STUDY_VARIABLES: [(&str, &str, &str); 3] = [

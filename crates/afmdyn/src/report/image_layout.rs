@@ -1,12 +1,11 @@
 //! The layouts of an image, declared beside the image's types as a chart's beside the chart
 //! (a layout module knows no request): `image.nc` of `afmdyn image --out DIR` ([`crate::layout::netcdf::write`])
 //! and the variables' units and long names of Python's `afmdyn.image` Dataset — the
-//! ideal-feedback image ([`crate::request::image::Image`], [`layout`]) and the PI scan
-//! ([`crate::request::image_scan::PiImage`], [`scan_layout`]).
+//! ideal-feedback image ([`crate::report::image::Image`], [`layout`]) and the PI scan
+//! ([`crate::report::image::PiImage`], [`scan_layout`]).
 
-use super::image::{Image, Regime, FIELDS};
-use super::image_peakforce::{PeakForceImage, PF_FIELDS};
-use super::image_scan::{scan_cells, PiImage, SCAN_FIELDS};
+use super::image::SCAN_FIELDS;
+use super::image::{scan_cells, Image, PeakForceImage, PiImage, Regime, FIELDS, PF_FIELDS};
 use crate::layout::columns::{self, UnitNames};
 use crate::layout::{Attr, Layout, Values, Variable};
 

@@ -5,12 +5,10 @@
 use crate::error::number;
 use crate::layout::columns::UnitNames;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
+use crate::report::image::{DomainContrast, Image, OperatingPoint, PeakForceImage, PiImage};
+use crate::report::image::{SetpointStudy, PF_FIELDS};
+use crate::report::image_layout::{layout, number_summary, peakforce_layout, scan_layout, summary};
 use crate::report::{Presentation, TextUnits};
-use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
-use crate::request::image_layout::number_summary;
-use crate::request::image_layout::{layout, peakforce_layout, scan_layout, summary};
-use crate::request::image_peakforce::{PeakForceImage, PF_FIELDS};
-use crate::request::image_scan::PiImage;
 use serde_json::{json, Value};
 
 /// A profile's series: its label, style and value at pixel i of the first line.
@@ -140,7 +138,7 @@ fn study_plots(s: &mut Presentation, study: &SetpointStudy) {
 
 /// The summary document of an ideal-feedback image at `setpoint` (`afmdyn image --json`,
 /// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
-/// (`crate::request::image_layout::summary`: per map `min`, `max`, `mean`; per code map the
+/// (`crate::report::image_layout::summary`: per map `min`, `max`, `mean`; per code map the
 /// pixels of each meaning); `feedback`, `setpoint`, `reference_z_c` (m), `materials` with their
 /// operating points, `warnings`, and the setpoint study (`"setpoint_study"`) when one was
 /// asked for. `ideal_document` is the document with every pixel.
@@ -162,7 +160,7 @@ pub fn ideal_summary(img: &Image, setpoint: f64, study: Option<&SetpointStudy>) 
 
 /// The summary document of a PI-scanned image at `setpoint` (`afmdyn image --feedback pi
 /// --json`, `image.json`; the maps are `image.nc`'s): `image`, the maps of trace, retrace and
-/// ideal image summarised (`crate::request::image_layout::summary`); `feedback`, `scan` (the
+/// ideal image summarised (`crate::report::image_layout::summary`); `feedback`, `scan` (the
 /// settings), `artefacts` of `trace` and `retrace`, `setpoint`, `reference_z_c` (m),
 /// `materials`, `warnings`. [`PiImage::document`] is the document with every pixel.
 pub fn pi_summary(img: &PiImage, setpoint: f64) -> Value {
@@ -365,7 +363,7 @@ pub(crate) fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -
 
 /// The summary document of a PeakForce image (`afmdyn image --mode peakforce --json`,
 /// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
-/// ([`crate::request::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
+/// ([`crate::report::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
 /// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point,
 /// as [`PeakForceImage::document_head`], and its pixels: `pixels`, `taps` the steady taps of
 /// the continuations into them, `reengaged`, and `maps`, each of `PF_FIELDS` summarised
