@@ -37,7 +37,7 @@ pub enum Regime {
 }
 
 /// One operating point of a material at the setpoint, in SI: the rest distance and the
-/// observables interpolated there ([`crate::report::setpoint`]).
+/// observables interpolated there (`crate::report::setpoint`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OperatingPoint {
     /// `approach` or `retract`: the sweep it lies on.
@@ -143,7 +143,7 @@ impl Image {
     }
 
     /// Apparent height of a pixel (m): h + z_c − z_c,ref (NaN where not reached).
-    pub fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
+    pub(crate) fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
         let p = &self.pixels[line][pixel];
         self.point(line, pixel)
             .map_or(f64::NAN, |o| p.height + o.z_c - self.reference)
@@ -281,7 +281,7 @@ pub(crate) fn scan_cells(d: usize, shape: (usize, usize)) -> Vec<ScanCell> {
 
 impl PiImage {
     /// Metres per model length unit g₀ (the records' lengths).
-    pub fn length(&self) -> f64 {
+    pub(crate) fn length(&self) -> f64 {
         self.units.length
     }
 
@@ -306,7 +306,7 @@ impl PiImage {
 
     /// Recorded height (m) of pixel (j, i) in direction `d`: the mean piezo position less the
     /// ideal image's reference.
-    pub fn height(&self, d: usize, j: usize, i: usize) -> f64 {
+    pub(crate) fn height(&self, d: usize, j: usize, i: usize) -> f64 {
         self.row(d, j)[i].z * self.units.length - self.ideal.reference
     }
 
@@ -507,7 +507,7 @@ pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
 
 impl PeakForceImage {
     /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
-    pub fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
+    pub(crate) fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
         self.pixels[line][pixel].tap.as_ref()
     }
 

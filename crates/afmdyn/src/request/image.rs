@@ -51,7 +51,7 @@ mod sample;
 mod study;
 pub use study::{setpoint_study, study_ratios, MAX_STUDY_RATIOS};
 
-pub use crate::report::image::{DomainContrast, SetpointStudy};
+pub(crate) use crate::report::image::{DomainContrast, SetpointStudy};
 pub use crate::report::image::{Image, Material, OperatingPoint, Pixel, Regime};
 
 pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};

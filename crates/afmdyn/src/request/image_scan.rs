@@ -46,7 +46,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
 
-pub use crate::report::image::{Artefacts, PiImage, ScanSettings};
+pub(crate) use crate::report::image::{Artefacts, PiImage, ScanSettings};
 
 /// Most drive periods a scan may integrate (lines × (engage + 2 × pixels × periods per pixel)).
 pub(crate) const MAX_SCAN_PERIODS: u64 = 1_000_000_000;

@@ -274,7 +274,7 @@ fn sum_squares(obs: &Observations, f: &[f64]) -> f64 {
 ///
 /// `params`, `start` and `fixed` have the model's n entries; `obs` its m points.
 #[cfg(test)]
-pub fn minimize(
+pub(crate) fn minimize(
     model: &dyn CurveModel,
     obs: &Observations,
     params: &[Parameter],
