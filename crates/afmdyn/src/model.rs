@@ -631,7 +631,6 @@ impl CantileverModel {
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
     /// For the point-mass and eigenmode models, the tip deflection Σ z_j at every ξ.
-    #[cfg(test)]
     pub fn deflection(&self, xi: f64, z: &DVector<f64>) -> f64 {
         if self.params.structure.is_lumped() {
             return z.rows(0, self.modes()).sum();
