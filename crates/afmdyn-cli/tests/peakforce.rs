@@ -168,8 +168,7 @@ fn adhesive_air_probe(dir: &std::path::Path, modulus: &str) -> std::path::PathBu
 fn a_peakforce_image_carries_the_probes_tabor_warning() {
     let dir = tempfile::tempdir().unwrap();
     let probe_path = adhesive_air_probe(dir.path(), "2e8");
-    let sample = dir.path().join("flat.toml");
-    std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
+    let sample = common::flat_sample(dir.path());
     let tabor = "the sample's Tabor parameter is 14.9";
     let single = afmdyn(&[
         "peakforce",

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use crate::common;
-use common::{column, json, repo, run};
+use common::{column, json, refused, repo, run};
 
 /// The probe's parameters reach the model: `modes` reports the first free frequency f₀ of the
 /// probe in Hz (the calibration it was built from), and `orbit` the probe's α's.
@@ -415,17 +415,6 @@ fn probe_file(dir: &Path, name: &str, text: &str) -> String {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     path.to_str().unwrap().to_string()
-}
-
-/// Exit 2 with one line on stderr containing every needle.
-fn refused(args: &[&str], needles: &[&str]) {
-    let out = run(args);
-    assert_eq!(out.status.code(), Some(2), "{args:?}");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {err} lacks {n}");
-    }
 }
 
 /// A dimensionless model flag under a probe is refused naming the SI key or flag to use

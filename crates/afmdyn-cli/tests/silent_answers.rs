@@ -349,8 +349,7 @@ fn an_am_image_carries_the_probes_warnings() {
         .replace("youngs_modulus = 4e9", "youngs_modulus = 50e6");
     assert!(text.contains("youngs_modulus = 50e6"));
     let probe = probe_file("am-image-tabor", &text);
-    let sample = probe.with_file_name("flat.toml");
-    std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
+    let sample = common::flat_sample(probe.parent().unwrap());
     let out = run(&[
         "image",
         "--probe",

@@ -59,3 +59,11 @@ pub fn refused(args: &[&str], needles: &[&str]) {
         assert!(err.contains(n), "{args:?}: {n:?} not in {err}");
     }
 }
+
+/// A flat sample map of 1 µm × 1 µm (no height map, one material) written in `dir`: the
+/// `--sample` of an image test that is about the probe, not the topography.
+pub fn flat_sample(dir: &Path) -> PathBuf {
+    let sample = dir.join("flat.toml");
+    std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
+    sample
+}
