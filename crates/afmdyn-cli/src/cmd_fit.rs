@@ -13,7 +13,7 @@ use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
 use crate::flags_afm::FitFlags;
-use afmdyn::request::run::Analysis;
+use afmdyn::request::run::Request;
 use afmdyn::request::Params;
 use afmdyn::request::Resolved;
 use clap::Args;

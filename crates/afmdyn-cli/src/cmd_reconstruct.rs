@@ -152,7 +152,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
         (None, Some(fm)) => {
             let request = request_of(a, fm)?;
             // the cantilever's constants refused naming their flags
-            request::Analysis::validate(&request, &model).map_err(flagged)?;
+            request::Request::validate(&request, &model).map_err(flagged)?;
             door::run(&request, &model, exit).map(drop)
         }
         (None, None) => Err(CliError::Input(

@@ -7,7 +7,7 @@ use crate::errors::{probe_error, sim_error};
 use crate::params::PyParams;
 use afmdyn::probe::Probe;
 use afmdyn::report;
-use afmdyn::request::{self, Analysis};
+use afmdyn::request::{self, Request};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

@@ -28,6 +28,11 @@ pub const FORCE_SIGN: &str = "positive when the sample pushes the tip away (repu
     van der Waals force in free flight)";
 
 use serde::{Deserialize, Serialize};
+
+/// Largest damping coefficients α3 and α6 (the beam's and the contact's, and a law's dashpot
+/// that makes α6, [`sls`]): the damping rate sets the stiffness of the system, and the exact
+/// grid needs about α·T steps per drive period (see `GRID_BUDGET_BYTES`).
+pub(crate) const DAMPING_MAX: f64 = 1e4;
 use std::fmt;
 use std::str::FromStr;
 

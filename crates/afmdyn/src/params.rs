@@ -25,9 +25,7 @@ pub(crate) const ALPHA1_MAX: f64 = 1e4;
 /// stop as diverged at a state norm of `STATE_NORM_MAX`; beyond 10⁶ products such as the
 /// squared gap in the contact energy leave the range where the switching search is reliable.
 pub(crate) const DISPLACEMENT_MAX: f64 = 1e6;
-/// Largest damping coefficients α3 and α6: the damping rate sets the stiffness of the system,
-/// and the exact grid needs about α·T steps per drive period (see `GRID_BUDGET_BYTES`).
-pub(crate) const DAMPING_MAX: f64 = 1e4;
+pub(crate) use crate::contact::DAMPING_MAX;
 /// Largest contact stiffness α4: contact frequencies grow as √(4Nα4); beyond 10⁸ the contact
 /// system is both stiff and ill-conditioned.
 pub(crate) const ALPHA4_MAX: f64 = 1e8;

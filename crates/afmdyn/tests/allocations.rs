@@ -4,7 +4,7 @@
 //! nonlinear tip–sample law. (A located event allocates: its record carries the state.)
 //!
 //! The same allocator also keeps the live heap bytes and their peak (over all threads), against
-//! which a request's declared memory ([`afmdyn::request::Analysis::cost`]) is checked.
+//! which a request's declared memory ([`afmdyn::request::Request::cost`]) is checked.
 
 use afmdyn::integrate::adaptive::Adaptive;
 use afmdyn::integrate::taylor::Taylor;
@@ -155,9 +155,7 @@ fn peak_of<T>(f: impl FnOnce() -> T) -> (f64, T) {
 #[test]
 fn declared_memory_bounds_the_measured_peak() {
     use afmdyn::analysis::progress::Progress;
-    use afmdyn::request::{
-        run, Analysis, ApproachRequest, ConvergeRequest, CurveRequest, Resolved,
-    };
+    use afmdyn::request::{run, ApproachRequest, ConvergeRequest, CurveRequest, Request, Resolved};
     let model = Resolved::plain(Params::default());
     let converge = ConvergeRequest {
         max_modes: 3,

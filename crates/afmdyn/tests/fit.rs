@@ -270,7 +270,7 @@ fn a_force_curve_fit_needs_only_the_spring_constant_tip_and_sample() {
     let (h, f) = synthetic(400, 50e-12, 3);
     let req = request(h, f, &[YOUNGS_MODULUS, "contact_point"]);
     assert_eq!(
-        afmdyn::request::run::Analysis::probe_needs(&req),
+        afmdyn::request::run::Request::probe_needs(&req),
         ProbeNeeds::Static
     );
     let minimal = Resolved {

@@ -389,7 +389,7 @@ fn the_declared_cost_counts_the_profiles_refits() {
     use afmdyn::analysis::fit::least_squares::{max_evaluations, PATIENCE};
     use afmdyn::analysis::fit::profile::REFIT_PATIENCE;
     use afmdyn::request::fit::FitRequest;
-    use afmdyn::request::{admit, Analysis, Resolved};
+    use afmdyn::request::{admit, Request, Resolved};
     let dir = std::env::temp_dir().join(format!("afmdyn-fit-cost-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let path = dir.join("am.csv");

@@ -183,6 +183,7 @@ proptest! {
 mod costs {
     use afmdyn::analysis::progress::Progress;
     use afmdyn::request::limits::{Cost, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
+    use afmdyn::request::Request;
     use afmdyn::request::{
         run, Analysis, ApproachRequest, AttractorsRequest, BasinsRequest, ContinuationRequest,
         ConvergeRequest, FmRequest, GlobalContinuationRequest, LyapunovRequest, ModesRequest,

@@ -92,12 +92,12 @@ impl Law for SlsLaw {
         let maxwell_stiffness = k2 * si.g0 / si.force;
         let alpha6 = maxwell_stiffness * tau_r / si.time;
         // the dashpot's group is the model's α6: name the SI keys that make it, not α6
-        if alpha6 > crate::params::DAMPING_MAX {
+        if alpha6 > super::DAMPING_MAX {
             return Err(format!(
                 "[sample].maxwell_stiffness = {k2:e} N/m with relaxation_time = {tau_r:e} s: \
                  the dashpot η = k2·τ_r gives α6 = {alpha6:.3e}, beyond {:e} (too stiff a \
                  dashpot for the integration grid; check the units, N/m and s)",
-                crate::params::DAMPING_MAX
+                super::DAMPING_MAX
             ));
         }
         Ok((SlsLaw { maxwell_stiffness }, alpha4, alpha6))

@@ -167,7 +167,10 @@ impl Default for IntegratorOptions {
 ///
 /// # Errors
 /// As [`CantileverModel::new`] and [`build`].
-pub fn check_buildable(params: &crate::Params, opts: IntegratorOptions) -> Result<(), SimError> {
+pub fn check_buildable(
+    params: &crate::params::Params,
+    opts: IntegratorOptions,
+) -> Result<(), SimError> {
     let model = CantileverModel::new(params)?;
     build(&model, opts, 0.0, &model.rest()).map(|_| ())
 }
@@ -179,7 +182,7 @@ pub fn check_buildable(params: &crate::Params, opts: IntegratorOptions) -> Resul
 /// # Errors
 /// As [`check_buildable`].
 pub fn check_buildable_over(
-    base: &crate::Params,
+    base: &crate::params::Params,
     param: SweepParam,
     values: &[f64],
     opts: IntegratorOptions,

@@ -317,7 +317,7 @@ pub struct Probe {
     pub assumed: Vec<String>,
 }
 
-/// What a request uses of a probe ([`crate::request::run::Analysis::probe_needs`]).
+/// What a request uses of a probe ([`crate::request::run::Request::probe_needs`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ProbeNeeds {
     /// The oscillating lever: `model`, the cantilever's resonance and Q, and `[drive]`, as

@@ -746,7 +746,6 @@ impl BifurcationRequest {
 pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 
 #[cfg(test)]
-#[path = "analyses_tests.rs"]
 mod tests;
 
 /// Most drive periods [`advance_from_rest`] integrates.

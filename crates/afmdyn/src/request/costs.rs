@@ -1,4 +1,4 @@
-//! What a request costs before it runs ([`super::Analysis::cost`]): its peak memory and its
+//! What a request costs before it runs ([`super::Request::cost`]): its peak memory and its
 //! work, estimated for the worst case its options allow, and held by [`super::run()`] against
 //! the budgets of [`super::limits`] ([`check_cost`]), so that a request too large is refused
 //! naming its cost and the budget — before any allocation or integration — instead of

@@ -8,7 +8,7 @@
 use super::fit_result::probe_value;
 pub(crate) use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
-use super::run::{Analysis, Resolved};
+use super::run::{Analysis, Request, Resolved};
 use crate::analysis::fit::force_curve::{
     self, preprocess, ForceCurveModel, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
     RADIUS, YOUNGS_MODULUS,
@@ -480,8 +480,7 @@ fn sls_start_warning(model: &SlsCurveModel, p: &[f64]) -> Option<String> {
     })
 }
 
-impl Analysis for FitRequest {
-    type Output = FitResult;
+impl Request for FitRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         if super::fit_dynamic::read_am_data(self.data.as_deref())?.is_some() {
             // an AM curve: its names and columns are checked when it runs; a probe read
@@ -493,6 +492,42 @@ impl Analysis for FitRequest {
         }
         self.check(model).map(|_| ())
     }
+    fn name(&self) -> &'static str {
+        "fit"
+    }
+    /// A force curve uses the probe's spring constant, tip and sample only; an AM, FM or
+    /// bimodal curve refuses the values a quasi-static read stood in for
+    /// (`super::fit_dynamic::am_probe`).
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Static
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // an AM curve: its stepped approaches, the profiles' refits included
+        if let Some(d) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
+            let law = model
+                .probe
+                .as_ref()
+                .map_or("", |p| p.params.contact_law.name());
+            let default_fit = self.fit == FitRequest::default().fit;
+            let n = super::fit_dynamic::fitted_names(&self.fit, default_fit, law).len();
+            let profiles = self.profiles.unwrap_or(false);
+            return super::fit_dynamic::cost(d.z.len(), n, profiles, &model.params);
+        }
+        // no integration; the columns, the preprocessed curve and the Jacobian (≤ 5 columns)
+        let rows = if self.data.is_some() {
+            MAX_FIT_ROWS
+        } else {
+            self.force.len()
+        } as f64;
+        Ok(Cost {
+            bytes: rows * 8.0 * 16.0,
+            work: 0.0,
+        })
+    }
+}
+
+impl Analysis for FitRequest {
+    type Output = FitResult;
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
         if let Some(data) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
             return super::fit_dynamic::execute(
@@ -581,38 +616,6 @@ impl Analysis for FitRequest {
             fitted,
             outcome,
             dynamic: None,
-        })
-    }
-    fn name(&self) -> &'static str {
-        "fit"
-    }
-    /// A force curve uses the probe's spring constant, tip and sample only; an AM, FM or
-    /// bimodal curve refuses the values a quasi-static read stood in for
-    /// (`super::fit_dynamic::am_probe`).
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Static
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // an AM curve: its stepped approaches, the profiles' refits included
-        if let Some(d) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
-            let law = model
-                .probe
-                .as_ref()
-                .map_or("", |p| p.params.contact_law.name());
-            let default_fit = self.fit == FitRequest::default().fit;
-            let n = super::fit_dynamic::fitted_names(&self.fit, default_fit, law).len();
-            let profiles = self.profiles.unwrap_or(false);
-            return super::fit_dynamic::cost(d.z.len(), n, profiles, &model.params);
-        }
-        // no integration; the columns, the preprocessed curve and the Jacobian (≤ 5 columns)
-        let rows = if self.data.is_some() {
-            MAX_FIT_ROWS
-        } else {
-            self.force.len()
-        } as f64;
-        Ok(Cost {
-            bytes: rows * 8.0 * 16.0,
-            work: 0.0,
         })
     }
     fn report(&self, _: &Resolved, r: &FitResult) -> Result<Value, SimError> {

@@ -7,7 +7,7 @@
 use super::costs::{newton_work, state_bytes, MODEL_BYTES};
 use super::curves::CurveRequest;
 use super::limits::Cost;
-use super::run::{Analysis, Resolved};
+use super::run::{Analysis, Request, Resolved};
 use crate::analysis::approach::approach_spec;
 use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
 use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference, FmSpec};
@@ -231,15 +231,10 @@ impl FmRequest {
     }
 }
 
-impl Analysis for FmRequest {
-    type Output = FmCurve;
+impl Request for FmRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         super::curves::check_single_frequency(&model.params, "fm")?;
         self.spec(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
-        super::curves::check_single_frequency(&model.params, "fm")?;
-        fm_curve(&self.spec(model)?, progress)
     }
     fn name(&self) -> &'static str {
         "fm"
@@ -258,6 +253,14 @@ impl Analysis for FmRequest {
             bytes: MODEL_BYTES + points * (4.0 * state_bytes(p) + 512.0),
             work: points * steps * newton_work(p, 1, &spec.newton),
         })
+    }
+}
+
+impl Analysis for FmRequest {
+    type Output = FmCurve;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
+        super::curves::check_single_frequency(&model.params, "fm")?;
+        fm_curve(&self.spec(model)?, progress)
     }
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
         Ok(document(self, model, curve))

@@ -48,7 +48,7 @@ pub(crate) fn check_threads(threads: Option<usize>) -> Result<(), crate::SimErro
         _ => Ok(()),
     }
 }
-/// What a request costs ([`crate::request::Analysis::cost`]), estimated before it runs for the
+/// What a request costs ([`crate::request::Request::cost`]), estimated before it runs for the
 /// worst case its options allow (`crate::request::costs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cost {

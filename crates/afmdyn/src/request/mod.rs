@@ -90,7 +90,7 @@ pub(crate) use pool::in_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
     admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document,
-    Presenting, Resolved, ResonanceRequest,
+    Presenting, Request, Resolved, ResonanceRequest,
 };
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a

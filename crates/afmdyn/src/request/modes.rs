@@ -4,7 +4,7 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::run::{Analysis, Resolved};
+use super::run::{Analysis, Request, Resolved};
 use crate::analysis::progress::Progress;
 use crate::eigen::{fig3_sweep, spectrum, Fig3Point, RegionSpectrum};
 use crate::error::SimError;
@@ -27,13 +27,9 @@ const NO_WORK: Cost = Cost {
 #[serde(deny_unknown_fields)]
 pub struct ModesRequest {}
 
-impl Analysis for ModesRequest {
-    type Output = (RegionSpectrum, RegionSpectrum);
+impl Request for ModesRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         Ok(model.params.validate_fields()?)
-    }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        Ok(spectrum(&model.params)?)
     }
     fn name(&self) -> &'static str {
         "modes"
@@ -41,6 +37,13 @@ impl Analysis for ModesRequest {
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         // two eigenproblems of 2N × 2N: no integration
         Ok(NO_WORK)
+    }
+}
+
+impl Analysis for ModesRequest {
+    type Output = (RegionSpectrum, RegionSpectrum);
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        Ok(spectrum(&model.params)?)
     }
     fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
         Ok(report::modes(&model.params, free, contact))
@@ -69,17 +72,9 @@ pub struct Fig3Request {
     pub out: String,
 }
 
-impl Analysis for Fig3Request {
-    type Output = Vec<Fig3Point>;
+impl Request for Fig3Request {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         Ok(model.params.validate_fields()?)
-    }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        let (alpha1, alpha4) = (
-            crate::report::present::modes::fig3_alpha1(),
-            crate::report::present::modes::fig3_alpha4(),
-        );
-        Ok(fig3_sweep(model.params.modes, &alpha1, &alpha4)?)
     }
     fn name(&self) -> &'static str {
         "modes"
@@ -87,6 +82,17 @@ impl Analysis for Fig3Request {
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         // 11 × 101 eigenproblems of 2N × 2N: no integration
         Ok(NO_WORK)
+    }
+}
+
+impl Analysis for Fig3Request {
+    type Output = Vec<Fig3Point>;
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        let (alpha1, alpha4) = (
+            crate::report::present::modes::fig3_alpha1(),
+            crate::report::present::modes::fig3_alpha4(),
+        );
+        Ok(fig3_sweep(model.params.modes, &alpha1, &alpha4)?)
     }
     fn report(&self, model: &Resolved, points: &Self::Output) -> Result<Value, SimError> {
         Ok(json!({ "params": model.params, "points": points, "out": self.out }))
@@ -119,23 +125,26 @@ pub struct UnitsRequest {
     pub physical: Option<PhysicalModel>,
 }
 
-impl Analysis for UnitsRequest {
-    /// The physical model's dimensionless set and scales (`None`: the probe's model).
-    type Output = Option<(Params, Scales)>;
+impl Request for UnitsRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         Ok(())
-    }
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        match &self.physical {
-            Some(m) => Ok(Some((m.to_params()?, m.scales()))),
-            None => Ok(None),
-        }
     }
     fn name(&self) -> &'static str {
         "units"
     }
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         Ok(NO_WORK)
+    }
+}
+
+impl Analysis for UnitsRequest {
+    /// The physical model's dimensionless set and scales (`None`: the probe's model).
+    type Output = Option<(Params, Scales)>;
+    fn execute(&self, _: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        match &self.physical {
+            Some(m) => Ok(Some((m.to_params()?, m.scales()))),
+            None => Ok(None),
+        }
     }
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError> {
         Ok(match output {
@@ -171,12 +180,8 @@ impl Analysis for UnitsRequest {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CantileversRequest {}
 
-impl Analysis for CantileversRequest {
-    type Output = ();
+impl Request for CantileversRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<(), SimError> {
         Ok(())
     }
     fn name(&self) -> &'static str {
@@ -184,6 +189,13 @@ impl Analysis for CantileversRequest {
     }
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         Ok(NO_WORK)
+    }
+}
+
+impl Analysis for CantileversRequest {
+    type Output = ();
+    fn execute(&self, _: &Resolved, _: &Progress) -> Result<(), SimError> {
+        Ok(())
     }
     fn report(&self, _: &Resolved, _: &()) -> Result<Value, SimError> {
         Ok(crate::cantilevers::document())

@@ -93,7 +93,7 @@ pub trait Named: Send {
     fn checks_cancel(&self) -> bool {
         true
     }
-    /// What the request uses of a probe ([`Analysis::probe_needs`]).
+    /// What the request uses of a probe ([`super::Request::probe_needs`]).
     fn probe_needs(&self) -> crate::probe::ProbeNeeds {
         crate::probe::ProbeNeeds::Oscillation
     }

@@ -30,7 +30,7 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::run::{Analysis, Resolved};
+use super::run::{Analysis, Request, Resolved};
 use crate::analysis::progress::Progress;
 use crate::analysis::reconstruct::{sader_jarvis, Method, Reconstruction, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
@@ -292,19 +292,12 @@ impl ReconstructRequest {
     }
 }
 
-impl Analysis for ReconstructRequest {
-    type Output = Reconstruction;
+impl Request for ReconstructRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         let curve = self.curve()?;
         match self.inversion {
             FmInversion::SaderJarvis => curve.method().map(|_| ()),
             FmInversion::Exact => check_exact(&curve),
-        }
-    }
-    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
-        match self.inversion {
-            FmInversion::SaderJarvis => sader_jarvis(&self.curve()?, progress),
-            FmInversion::Exact => exact_inversion(&self.curve()?, progress),
         }
     }
     fn name(&self) -> &'static str {
@@ -331,6 +324,16 @@ impl Analysis for ReconstructRequest {
             bytes: MODEL_BYTES + work_bytes + 5.0 * 8.0 * n as f64,
             work: 0.0,
         })
+    }
+}
+
+impl Analysis for ReconstructRequest {
+    type Output = Reconstruction;
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
+        match self.inversion {
+            FmInversion::SaderJarvis => sader_jarvis(&self.curve()?, progress),
+            FmInversion::Exact => exact_inversion(&self.curve()?, progress),
+        }
     }
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(document(self, r))
@@ -369,14 +372,9 @@ fn present_reconstruction(
 #[derive(Debug, Clone)]
 pub struct AmReconstruction(pub Value);
 
-impl Analysis for AmReconstruction {
-    type Output = Reconstruction;
+impl Request for AmReconstruction {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         am_curve_from_approach(&self.0).map(|_| ())
-    }
-    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
-        let curve = am_curve_from_approach(&self.0)?;
-        crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)
     }
     fn name(&self) -> &'static str {
         "reconstruct"
@@ -389,6 +387,14 @@ impl Analysis for AmReconstruction {
             bytes: MODEL_BYTES + 12.0 * 8.0 * n,
             work: 0.0,
         })
+    }
+}
+
+impl Analysis for AmReconstruction {
+    type Output = Reconstruction;
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
+        let curve = am_curve_from_approach(&self.0)?;
+        crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)
     }
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(am_document(&am_curve_from_approach(&self.0)?, r))

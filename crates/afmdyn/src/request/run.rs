@@ -77,27 +77,15 @@ pub struct Document<T> {
     pub json: Value,
 }
 
-/// An analysis request that [`run`] takes from its model to its [`Document`].
-pub trait Analysis {
-    /// The typed result.
-    type Output;
+/// What a user asks, before any work: its name, its checks on the model and its declared cost
+/// ([`admit`]), and what it uses of a probe. Every [`Analysis`] is one.
+pub trait Request {
     /// Check every option on `model` without computing (a front end calls it before its side
     /// effects, such as locking an output directory; [`run`] calls it first).
     ///
     /// # Errors
     /// The request's validation errors, naming the parameter and its range.
     fn validate(&self, model: &Resolved) -> Result<(), SimError>;
-    /// Validate the request and compute its result on `model`, counting in `progress`.
-    ///
-    /// # Errors
-    /// The request's validation errors (naming the parameter and its range) and the
-    /// analysis' failures; [`SimError::Cancelled`] when `progress` is cancelled.
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError>;
-    /// The document of a result, without the SI block ([`run`] adds it).
-    ///
-    /// # Errors
-    /// [`SimError`] where the document needs the model built again (an invalid `params`).
-    fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
     /// The request's name in its refusals (`"attractors"`).
     fn name(&self) -> &'static str;
     /// What the request uses of a probe, which a front end reads it for
@@ -108,7 +96,7 @@ pub trait Analysis {
     /// What the request costs on `model` — peak memory and work in mode-periods
     /// (`super::costs`) — estimated for the worst case its options allow, before any work;
     /// [`run`] refuses it beyond `super::limits::MAX_REQUEST_BYTES` or
-    /// `super::limits::MAX_REQUEST_WORK`. Called after [`Analysis::validate`].
+    /// `super::limits::MAX_REQUEST_WORK`. Called after [`Request::validate`].
     ///
     /// # Errors
     /// As the analysis' validation.
@@ -122,11 +110,28 @@ pub trait Analysis {
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         Ok(model.params)
     }
-    /// The parameters `output` holds, for its SI block ([`document`]): [`Analysis::computed_at`],
+}
+
+/// A [`Request`] that [`run`] takes from its model to its [`Document`]: its execution, its
+/// document and its presentation (implemented beside the studies, `crate::study`).
+pub trait Analysis: Request {
+    /// The typed result.
+    type Output;
+    /// Compute the result on `model` (validated and admitted), counting in `progress`.
+    ///
+    /// # Errors
+    /// The analysis' failures; [`SimError::Cancelled`] when `progress` is cancelled.
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError>;
+    /// The document of a result, without the SI block ([`run`] adds it).
+    ///
+    /// # Errors
+    /// [`SimError`] where the document needs the model built again (an invalid `params`).
+    fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
+    /// The parameters `output` holds, for its SI block ([`document`]): [`Request::computed_at`],
     /// unless the result found one of them (a PeakForce setpoint's rest distance z_c).
     ///
     /// # Errors
-    /// As [`Analysis::computed_at`].
+    /// As [`Request::computed_at`].
     fn found_at(&self, model: &Resolved, _output: &Self::Output) -> Result<Params, SimError> {
         self.computed_at(model)
     }
@@ -170,7 +175,7 @@ pub struct Presenting<'a> {
     pub to: Destination<'a>,
 }
 
-/// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
+/// Run `analysis` on `model`: [`Request::validate`], its [`Request::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
 /// probe (`report::with_si`).
 ///
@@ -207,8 +212,8 @@ pub fn run_admitted<A: Analysis + ?Sized>(
     })
 }
 
-/// Admit `analysis` on `model` before any work: [`Analysis::validate`], then its
-/// [`Analysis::cost`] held against the budgets (`check_cost`) — [`run`]'s first step, and a
+/// Admit `analysis` on `model` before any work: [`Request::validate`], then its
+/// [`Request::cost`] held against the budgets (`check_cost`) — [`run`]'s first step, and a
 /// front end's for a request it runs itself (a study into its store, a run streamed to files).
 ///
 /// # Errors
@@ -220,7 +225,7 @@ pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(),
 }
 
 /// [`admit`] without the cost: the probe held against what the request uses of it
-/// ([`crate::probe::Probe::serves`]), then [`Analysis::validate`] — what a front end checks
+/// ([`crate::probe::Probe::serves`]), then [`Request::validate`] — what a front end checks
 /// before its side effects.
 ///
 /// # Errors
@@ -240,7 +245,7 @@ pub(crate) fn validate<A: Analysis + ?Sized>(
 /// store of its own.
 ///
 /// # Errors
-/// As [`Analysis::report`] and [`Analysis::computed_at`].
+/// As [`Analysis::report`] and [`Request::computed_at`].
 pub fn document<A: Analysis + ?Sized>(
     analysis: &A,
     model: &Resolved,
@@ -262,13 +267,9 @@ pub fn document<A: Analysis + ?Sized>(
     Ok(doc)
 }
 
-impl Analysis for OrbitRequest {
-    type Output = PeriodicOrbit;
+impl Request for OrbitRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         OrbitRequest::validate(self)
-    }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
-        self.run(&model.params)
     }
     fn name(&self) -> &'static str {
         "orbit"
@@ -284,6 +285,13 @@ impl Analysis for OrbitRequest {
             work: search + newton_work(p, period, &ShootingOptions::default()),
         })
     }
+}
+
+impl Analysis for OrbitRequest {
+    type Output = PeriodicOrbit;
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
+        self.run(&model.params)
+    }
     fn report(&self, model: &Resolved, o: &PeriodicOrbit) -> Result<Value, SimError> {
         Ok(report::orbit(&CantileverModel::new(&model.params)?, o))
     }
@@ -296,13 +304,9 @@ impl Analysis for OrbitRequest {
     }
 }
 
-impl Analysis for ContinuationRequest {
-    type Output = Vec<Branch>;
+impl Request for ContinuationRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         ContinuationRequest::validate(self, &model.params)
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
     }
     fn name(&self) -> &'static str {
         "continuation"
@@ -326,6 +330,13 @@ impl Analysis for ContinuationRequest {
                 + branches * points as f64 * newton_work(p, top, &ShootingOptions::default()),
         })
     }
+}
+
+impl Analysis for ContinuationRequest {
+    type Output = Vec<Branch>;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
     fn report(&self, model: &Resolved, branches: &Self::Output) -> Result<Value, SimError> {
         Ok(report::continuation(&model.params, self.param, branches))
     }
@@ -345,13 +356,9 @@ impl Analysis for ContinuationRequest {
     }
 }
 
-impl Analysis for LyapunovRequest {
-    type Output = LyapunovSpectrum;
+impl Request for LyapunovRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         LyapunovRequest::validate(self)
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
     }
     fn name(&self) -> &'static str {
         "lyapunov"
@@ -370,6 +377,13 @@ impl Analysis for LyapunovRequest {
             work: (transient + self.periods as f64) * (dim + 1.0) * p.modes as f64,
         })
     }
+}
+
+impl Analysis for LyapunovRequest {
+    type Output = LyapunovSpectrum;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
     fn report(&self, model: &Resolved, l: &Self::Output) -> Result<Value, SimError> {
         Ok(report::lyapunov(&model.params, l))
     }
@@ -386,13 +400,9 @@ impl Analysis for LyapunovRequest {
     }
 }
 
-impl Analysis for AttractorsRequest {
-    type Output = AttractorReport;
+impl Request for AttractorsRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
     }
     fn name(&self) -> &'static str {
         "attractors"
@@ -400,6 +410,13 @@ impl Analysis for AttractorsRequest {
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         let spec = self.spec(&model.params)?;
         census_cost(&spec, 1)
+    }
+}
+
+impl Analysis for AttractorsRequest {
+    type Output = AttractorReport;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
     }
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         Ok(report::attractors(&model.params, self.samples, r))
@@ -423,13 +440,9 @@ impl Analysis for AttractorsRequest {
     }
 }
 
-impl Analysis for ObserveRequest {
-    type Output = ObserveResult;
+impl Request for ObserveRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ObserveRequest::validate(self)
-    }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params)
     }
     fn name(&self) -> &'static str {
         "observe"
@@ -449,6 +462,13 @@ impl Analysis for ObserveRequest {
             work: search + newton_work(p, n, &newton) + (self.periods * n) as f64 * p.modes as f64,
         })
     }
+}
+
+impl Analysis for ObserveRequest {
+    type Output = ObserveResult;
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params)
+    }
     fn report(&self, model: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
         let units = CurveUnits::of(model.probe.as_ref(), false);
         let mut doc = report::observables(&o.observables);
@@ -457,19 +477,22 @@ impl Analysis for ObserveRequest {
     }
 }
 
-impl Analysis for ConvergeRequest {
-    type Output = Vec<ConvergenceRun>;
+impl Request for ConvergeRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ConvergeRequest::validate(self)
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
     }
     fn name(&self) -> &'static str {
         "converge"
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         converge_cost(self, &model.params)
+    }
+}
+
+impl Analysis for ConvergeRequest {
+    type Output = Vec<ConvergenceRun>;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
     }
     fn report(&self, model: &Resolved, runs: &Self::Output) -> Result<Value, SimError> {
         Ok(report::converge(&model.params, runs))

@@ -19,7 +19,7 @@ use crate::params::Params;
 use crate::report::basins::document;
 use crate::request::costs::{basins_cost, check_cost};
 use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Resolved};
+use crate::request::run::{Analysis, Request, Resolved};
 use crate::request::BasinsRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
@@ -95,23 +95,26 @@ impl BasinStudy {
     }
 }
 
-impl Analysis for BasinsRequest {
-    type Output = BasinMap;
+impl Request for BasinsRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
-        let study = BasinStudy::new(self, &model.params)?;
-        let records = execute_in_memory(&study.chain(), self.threads, progress)?;
-        crate::request::in_pool(self.threads, || {
-            study.map(records.into_iter().map(|(_, r)| r))
-        })
     }
     fn name(&self) -> &'static str {
         "basins"
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         basins_cost(&self.spec(&model.params)?)
+    }
+}
+
+impl Analysis for BasinsRequest {
+    type Output = BasinMap;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
+        let study = BasinStudy::new(self, &model.params)?;
+        let records = execute_in_memory(&study.chain(), self.threads, progress)?;
+        crate::request::in_pool(self.threads, || {
+            study.map(records.into_iter().map(|(_, r)| r))
+        })
     }
     fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
         let spec = self.spec(&model.params)?;

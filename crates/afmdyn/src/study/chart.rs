@@ -10,7 +10,7 @@ use crate::error::SimError;
 use crate::request::chart::chart_cost;
 use crate::request::chart::{document, Chart};
 use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Resolved};
+use crate::request::run::{Analysis, Request, Resolved};
 use serde_json::Value;
 
 impl Chart {
@@ -33,23 +33,26 @@ impl Chart {
 /// it from the request's model values, defaults and probe, validated every option and held
 /// its cost to the budgets — so the `model` given here is not read (pass
 /// [`Resolved::plain`] of any parameters). Its study runs in memory on its threads.
-impl Analysis for Chart {
-    type Output = Vec<ChartCell>;
+impl Request for Chart {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         Ok(())
-    }
-    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Vec<ChartCell>, SimError> {
-        let cells = cells_of(execute_in_memory(&self.tasks(), self.threads, progress)?);
-        match every_cell_failed(&cells) {
-            Some(e) => Err(e),
-            None => Ok(cells),
-        }
     }
     fn name(&self) -> &'static str {
         "chart"
     }
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         chart_cost(self)
+    }
+}
+
+impl Analysis for Chart {
+    type Output = Vec<ChartCell>;
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Vec<ChartCell>, SimError> {
+        let cells = cells_of(execute_in_memory(&self.tasks(), self.threads, progress)?);
+        match every_cell_failed(&cells) {
+            Some(e) => Err(e),
+            None => Ok(cells),
+        }
     }
     fn report(&self, _: &Resolved, cells: &Vec<ChartCell>) -> Result<Value, SimError> {
         Ok(document(self, cells))

@@ -21,7 +21,7 @@ use crate::params::Params;
 use crate::report;
 use crate::request::costs::{census_cost, check_cost};
 use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Resolved};
+use crate::request::run::{Analysis, Request, Resolved};
 use crate::request::GlobalContinuationRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -98,15 +98,9 @@ impl ContinuationStudy {
     }
 }
 
-impl Analysis for GlobalContinuationRequest {
-    type Output = Vec<ContinuationStep>;
+impl Request for GlobalContinuationRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        let study = ContinuationStudy::new(self, &model.params)?;
-        let records = execute_in_memory(&study.chain(), None, progress)?;
-        study.steps(records)
     }
     fn name(&self) -> &'static str {
         "attractors --sweep"
@@ -115,6 +109,15 @@ impl Analysis for GlobalContinuationRequest {
         // one census per value
         let spec = self.spec(&model.params)?;
         census_cost(&spec.census, spec.values.len())
+    }
+}
+
+impl Analysis for GlobalContinuationRequest {
+    type Output = Vec<ContinuationStep>;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        let study = ContinuationStudy::new(self, &model.params)?;
+        let records = execute_in_memory(&study.chain(), None, progress)?;
+        study.steps(records)
     }
     fn report(&self, model: &Resolved, steps: &Self::Output) -> Result<Value, SimError> {
         Ok(report::global_continuation(

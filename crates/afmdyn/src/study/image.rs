@@ -1,5 +1,5 @@
 //! `image` run ([`ImageJob`] as an [`Analysis`]): the request's data (`crate::request::image_job`)
-//! held against the budgets before any work ([`Analysis::cost`]: the materials' approach curves,
+//! held against the budgets before any work ([`Request::cost`]: the materials' approach curves,
 //! the pixels' memory and a scan's drive periods), run (the ideal feedback's image and setpoint
 //! study, [`super::scan::pi_image`], [`super::peakforce_image::peakforce_image`]) and presented
 //! (`crate::report::present::image`).
@@ -12,11 +12,11 @@ use crate::request::image_job::{ImageJob, ImageMode, ImageOutput};
 use crate::request::image_peakforce::{peakforce_cost, peakforce_probe};
 use crate::request::image_scan::resolve;
 use crate::request::limits::{check_threads, Cost};
-use crate::request::run::{Analysis, Resolved};
+use crate::request::run::{Analysis, Request, Resolved};
 use serde_json::Value;
 
 impl ImageJob {
-    /// [`Analysis::validate`] of a PeakForce image: the grid, an off-resonance probe, a
+    /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
     /// setpoint force > 0, no PI feedback and no setpoint study.
     fn validate_peakforce(&self) -> Result<(), SimError> {
         if self.feedback.is_some() || self.study.is_some() {
@@ -32,9 +32,7 @@ impl ImageJob {
     }
 }
 
-impl Analysis for ImageJob {
-    type Output = ImageOutput;
-
+impl Request for ImageJob {
     fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
         self.request.validate(&self.sample)?;
         check_threads(self.threads)?;
@@ -55,6 +53,40 @@ impl Analysis for ImageJob {
             (None, _) => Ok(()),
         }
     }
+
+    fn name(&self) -> &'static str {
+        "image"
+    }
+
+    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+        if self.mode == ImageMode::Peakforce {
+            return peakforce_cost(&self.probe, &self.sample, &self.request);
+        }
+        let background = background_probe(&self.probe)?;
+        let (map, req) = (&self.sample, &self.request);
+        let periods = match &self.feedback {
+            Some(scan) => resolve(&background, map, req, scan)?.2,
+            None => 0.0,
+        };
+        let extra = Cost {
+            bytes: req.pixel_bytes(map),
+            work: periods,
+        };
+        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
+        if self.study.is_some() {
+            // the study computes the materials' curves once more
+            let none = Cost {
+                bytes: 0.0,
+                work: 0.0,
+            };
+            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
+        }
+        Ok(cost)
+    }
+}
+
+impl Analysis for ImageJob {
+    type Output = ImageOutput;
 
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ImageOutput, SimError> {
         self.validate(model)?;
@@ -103,36 +135,6 @@ impl Analysis for ImageJob {
             ImageOutput::Pi(img) => crate::report::present::image::pi_summary(img, setpoint),
             ImageOutput::PeakForce(img) => crate::report::present::image::peakforce_summary(img),
         })
-    }
-
-    fn name(&self) -> &'static str {
-        "image"
-    }
-
-    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
-        if self.mode == ImageMode::Peakforce {
-            return peakforce_cost(&self.probe, &self.sample, &self.request);
-        }
-        let background = background_probe(&self.probe)?;
-        let (map, req) = (&self.sample, &self.request);
-        let periods = match &self.feedback {
-            Some(scan) => resolve(&background, map, req, scan)?.2,
-            None => 0.0,
-        };
-        let extra = Cost {
-            bytes: req.pixel_bytes(map),
-            work: periods,
-        };
-        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
-        if self.study.is_some() {
-            // the study computes the materials' curves once more
-            let none = Cost {
-                bytes: 0.0,
-                work: 0.0,
-            };
-            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
-        }
-        Ok(cost)
     }
 
     fn present(

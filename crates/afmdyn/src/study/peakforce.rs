@@ -25,7 +25,7 @@ use crate::request::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTE
 use crate::request::limits::Cost;
 use crate::request::peakforce::{document, setpoint_in_newtons, PeakForceResult};
 use crate::request::peakforce_sweep::SweepTap;
-use crate::request::{Analysis, PeakForceRequest, PeakForceSweep, Resolved};
+use crate::request::{Analysis, PeakForceRequest, PeakForceSweep, Request, Resolved};
 use nalgebra::DVector;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -119,47 +119,9 @@ impl PeakForceStudy {
     }
 }
 
-impl Analysis for PeakForceRequest {
-    type Output = PeakForceResult;
+impl Request for PeakForceRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.params(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
-        let p = self.params(model)?;
-        if let Some(sweep) = &self.sweep {
-            return execute_sweep(self, sweep, model, &p, progress);
-        }
-        match self.setpoint {
-            Some(f) => {
-                let force = Self::units(model).force;
-                let opts = SetpointOptions {
-                    tap: self.options(),
-                    ..SetpointOptions::default()
-                };
-                let s =
-                    peak_force_setpoint(&p, f / force, &opts).map_err(|e| match model.probe {
-                        Some(_) => setpoint_in_newtons(e, f),
-                        None => e,
-                    })?;
-                Ok(PeakForceResult {
-                    alpha5: s.alpha5,
-                    filtered: self.filtered(model, &p, &s.tap)?,
-                    tap: s.tap,
-                    evaluations: s.evaluations,
-                    sweep: None,
-                })
-            }
-            None => {
-                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
-                Ok(PeakForceResult {
-                    alpha5: p.alpha5,
-                    filtered: self.filtered(model, &p, &tap)?,
-                    tap,
-                    evaluations: 1,
-                    sweep: None,
-                })
-            }
-        }
     }
     fn name(&self) -> &'static str {
         "peakforce"
@@ -198,6 +160,47 @@ impl Analysis for PeakForceRequest {
     }
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         self.params(model)
+    }
+}
+
+impl Analysis for PeakForceRequest {
+    type Output = PeakForceResult;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
+        let p = self.params(model)?;
+        if let Some(sweep) = &self.sweep {
+            return execute_sweep(self, sweep, model, &p, progress);
+        }
+        match self.setpoint {
+            Some(f) => {
+                let force = Self::units(model).force;
+                let opts = SetpointOptions {
+                    tap: self.options(),
+                    ..SetpointOptions::default()
+                };
+                let s =
+                    peak_force_setpoint(&p, f / force, &opts).map_err(|e| match model.probe {
+                        Some(_) => setpoint_in_newtons(e, f),
+                        None => e,
+                    })?;
+                Ok(PeakForceResult {
+                    alpha5: s.alpha5,
+                    filtered: self.filtered(model, &p, &s.tap)?,
+                    tap: s.tap,
+                    evaluations: s.evaluations,
+                    sweep: None,
+                })
+            }
+            None => {
+                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
+                Ok(PeakForceResult {
+                    alpha5: p.alpha5,
+                    filtered: self.filtered(model, &p, &tap)?,
+                    tap,
+                    evaluations: 1,
+                    sweep: None,
+                })
+            }
+        }
     }
     fn found_at(&self, model: &Resolved, r: &PeakForceResult) -> Result<Params, SimError> {
         // a setpoint's z_c is the one found; a sweep keeps the probe's (its values are listed)

@@ -25,7 +25,9 @@ use crate::report;
 use crate::report::present::curves::{stepped, CurveKind};
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
-use crate::request::run::{Analysis, ApproachRequest, Bimodal, Resolved, ResonanceRequest};
+use crate::request::run::{
+    Analysis, ApproachRequest, Bimodal, Request, Resolved, ResonanceRequest,
+};
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -156,13 +158,9 @@ macro_rules! present_curve {
     };
 }
 
-impl Analysis for ApproachRequest {
-    type Output = SteppedCurve;
+impl Request for ApproachRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        CurveStudy::approach(self, model)?.run_in_memory(progress)
     }
     fn name(&self) -> &'static str {
         "approach"
@@ -172,6 +170,13 @@ impl Analysis for ApproachRequest {
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         stepped_cost(&self.spec(model)?)
+    }
+}
+
+impl Analysis for ApproachRequest {
+    type Output = SteppedCurve;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        CurveStudy::approach(self, model)?.run_in_memory(progress)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
         let u = Self::units(model);
@@ -202,13 +207,9 @@ impl Analysis for ApproachRequest {
     present_curve!(CurveKind::Approach);
 }
 
-impl Analysis for ResonanceRequest {
-    type Output = SteppedCurve;
+impl Request for ResonanceRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        CurveStudy::resonance(self, model)?.run_in_memory(progress)
     }
     fn name(&self) -> &'static str {
         "resonance"
@@ -216,15 +217,22 @@ impl Analysis for ResonanceRequest {
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         stepped_cost(&self.spec(model)?)
     }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
+    }
+}
+
+impl Analysis for ResonanceRequest {
+    type Output = SteppedCurve;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        CurveStudy::resonance(self, model)?.run_in_memory(progress)
+    }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
         Ok(report::resonance(
             &self.computed_at(model)?,
             c,
             &Self::units(model),
         ))
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
     }
     fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
         Some(c.largest_indentation())
@@ -294,19 +302,10 @@ fn soft_sample_warning(
         if u.si { "m" } else { "g0" },
     ))
 }
-impl Analysis for Bimodal {
-    type Output = SteppedCurve;
+impl Request for Bimodal {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         crate::request::curves::check_bimodal(&model.params)?;
         self.0.validate(model)
-    }
-    fn execute(
-        &self,
-        model: &Resolved,
-        progress: &crate::analysis::progress::Progress,
-    ) -> Result<Self::Output, SimError> {
-        crate::request::curves::check_bimodal(&model.params)?;
-        self.0.execute(model, progress)
     }
     fn name(&self) -> &'static str {
         self.0.name()
@@ -316,6 +315,18 @@ impl Analysis for Bimodal {
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         self.0.cost(model)
+    }
+}
+
+impl Analysis for Bimodal {
+    type Output = SteppedCurve;
+    fn execute(
+        &self,
+        model: &Resolved,
+        progress: &crate::analysis::progress::Progress,
+    ) -> Result<Self::Output, SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        self.0.execute(model, progress)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<serde_json::Value, SimError> {
         self.0.report(model, c)

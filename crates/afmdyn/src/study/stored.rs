@@ -30,7 +30,9 @@ use crate::request::named::{self, Datasets, Outcome};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
 use crate::request::GlobalContinuationRequest;
-use crate::request::{Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock};
+use crate::request::{
+    Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock, Request,
+};
 use crate::request::{Resolved, ResonanceRequest};
 use serde::de::{DeserializeOwned, Deserializer};
 use serde::{Deserialize, Serialize};
@@ -313,19 +315,22 @@ pub struct SweepInto(pub BifurcationRequest);
 /// Why a sweep into files cannot run without a directory.
 const NO_DIRECTORY: &str = "a sweep into its store's files needs the store's directory";
 
-impl Analysis for SweepInto {
-    type Output = SweepFiles;
+impl Request for SweepInto {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.0.validate(model)
-    }
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<SweepFiles, SimError> {
-        Err(SimError::File(NO_DIRECTORY.into()))
     }
     fn name(&self) -> &'static str {
         self.0.name()
     }
     fn cost(&self, model: &Resolved) -> Result<crate::request::limits::Cost, SimError> {
         self.0.cost(model)
+    }
+}
+
+impl Analysis for SweepInto {
+    type Output = SweepFiles;
+    fn execute(&self, _: &Resolved, _: &Progress) -> Result<SweepFiles, SimError> {
+        Err(SimError::File(NO_DIRECTORY.into()))
     }
     fn report(&self, model: &Resolved, files: &SweepFiles) -> Result<Value, SimError> {
         let values = files.spec.values.len();

@@ -11,7 +11,7 @@ use crate::error::SimError;
 use crate::request::checkpoint::{end_state, point_count};
 use crate::request::costs::{state_bytes, steady_periods, MODEL_BYTES};
 use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Resolved};
+use crate::request::run::{Analysis, Request, Resolved};
 use crate::request::sweep::{records, SweepRecord};
 use crate::request::BifurcationRequest;
 use serde_json::Value;
@@ -83,20 +83,9 @@ impl Study for SweepStudy {
 /// the one order (`crate::request::sweep::order_key`). A front end that runs the sweep
 /// resumably into a store of its own (`afmdyn bifurcation --out DIR`) checks the same cost
 /// first ([`crate::request::run::admit`]) and runs the [`SweepStudy`] itself.
-impl Analysis for BifurcationRequest {
-    type Output = Vec<SweepRecord>;
+impl Request for BifurcationRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        let study = SweepStudy::new(self, self.spec(&model.params)?);
-        let mut records: Vec<SweepRecord> =
-            super::execute_in_memory(&study, self.threads, progress)?
-                .into_iter()
-                .flatten()
-                .collect();
-        records.sort_by_key(crate::request::sweep::order_key);
-        Ok(records)
     }
     fn name(&self) -> &'static str {
         "bifurcation"
@@ -124,6 +113,20 @@ impl Analysis for BifurcationRequest {
             bytes: MODEL_BYTES + points * recorded * record,
             work: (points + coarse) * (cap + recorded) * p.modes as f64,
         })
+    }
+}
+
+impl Analysis for BifurcationRequest {
+    type Output = Vec<SweepRecord>;
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        let study = SweepStudy::new(self, self.spec(&model.params)?);
+        let mut records: Vec<SweepRecord> =
+            super::execute_in_memory(&study, self.threads, progress)?
+                .into_iter()
+                .flatten()
+                .collect();
+        records.sort_by_key(crate::request::sweep::order_key);
+        Ok(records)
     }
     fn report(&self, model: &Resolved, records: &Self::Output) -> Result<Value, SimError> {
         let spec = self.spec(&model.params)?;
@@ -213,5 +216,4 @@ pub(crate) fn sweep_checkpoint(lock: &crate::io::dir_lock::DirLock) -> SweepChec
 }
 
 #[cfg(test)]
-#[path = "sweep_tests.rs"]
 mod tests;

@@ -198,9 +198,9 @@ mod tests {
     #[test]
     fn taylor_exponential_matches_pade() {
         for modes in [1usize, 3, 10] {
-            let p = crate::Params {
+            let p = crate::params::Params {
                 modes,
-                ..crate::Params::default()
+                ..crate::params::Params::default()
             };
             let m = CantileverModel::new(&p).unwrap();
             for r in [Region::Free, Region::Contact] {

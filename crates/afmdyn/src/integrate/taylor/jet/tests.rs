@@ -40,10 +40,10 @@ fn interior_tau_series_match_the_sigma_series() {
             intermolecular_distance: 0.05,
         },
     ] {
-        let m = CantileverModel::new(&crate::Params {
+        let m = CantileverModel::new(&crate::params::Params {
             contact_law: law,
             alpha6: 0.3,
-            ..crate::Params::default()
+            ..crate::params::Params::default()
         })
         .unwrap();
         let jet = Jet::new(&m).unwrap();
@@ -113,10 +113,10 @@ fn interior_tau_series_match_the_sigma_series() {
 /// recurrence, independent of the code's per-block products); Φ's series those of e^{As}.
 #[test]
 fn free_flight_series_solve_the_linear_equations() {
-    let m = CantileverModel::new(&crate::Params {
+    let m = CantileverModel::new(&crate::params::Params {
         contact_law: ContactLaw::Hertz,
         alpha5: 5.0,
-        ..crate::Params::default()
+        ..crate::params::Params::default()
     })
     .unwrap();
     let jet = Jet::new(&m).unwrap();
