@@ -461,12 +461,12 @@ class Field:
             return value
         if self.dim:
             if self.dim == "mode":
-                return f'self.{self.name}.value_in("{flag}", mode_dim, si)?'
+                return f'crate::args::value_in(self.{self.name}, "{flag}", mode_dim, si)?'
             dim = "swept" if self.dim == "swept" else DIMS[self.dim][0]
             if self.ty().startswith("Option"):
                 value = f'quantity(self.{self.name}, "{flag}", {dim}, si)?'
             else:
-                return f'self.{self.name}.value("{flag}", {dim}, si)?'
+                return f'crate::args::flag_value(self.{self.name}, "{flag}", {dim}, si)?'
         elif self.rust == "String" or self.rust.startswith("Vec<") or self.ty().startswith(
                 "Option<String"):
             value = f"self.{self.name}.clone()"

@@ -87,12 +87,12 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "fm": ("fm", "_fm", "xr.Dataset", {}),
         "peakforce": ("peakforce", "_peakforce", "xr.Dataset", {
-            "omit": ("sweep",), "typed": False,
+            "omit": ("sweep",),
             "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),
                          "fit_band": ("Optional[Sequence[float]]", "None")},
             "own": [("modulation_frequency", "Optional[Sequence[float]]", "None")] + PROGRESS}),
         "fit": ("fit", "_fit", "xr.Dataset", {
-            "omit": ("force", "height", "sigma", "time"), "typed": False, "rename": {"range": "fit_range"},
+            "omit": ("force", "height", "sigma", "time"), "rename": {"range": "fit_range"},
             "override": {
                 "data": ('Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None]',
                          "None"),
@@ -105,7 +105,7 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
             "omit": ("setpoint", "pixels", "lines"), "own": [],
             "override": {"curve_points": ("Optional[int]", "None")}}),
         "reconstruct": ("reconstruct", "_reconstruct", "xr.Dataset", {
-            "positional": [], "model": False, "typed": False, "omit": ("law_force",),
+            "positional": [], "model": False, "omit": ("law_force",),
             "override": {"frequency_shift": ("Optional[Sequence[float]]", "None"),
                          **{k: OPTIONAL_FLOAT for k in ("spring_constant",
                                                         "resonance_frequency", "amplitude")}},
@@ -298,6 +298,27 @@ def _layout_tables(name: str, doc: Dict[str, object]) -> List[str]:
     return out
 
 
+#: the dimensions a keyword's text with a unit may have (a request field's ``x-dim``)
+SI_DIMS = ("length", "frequency", "force")
+
+
+def _dims(stem: str, rename: Dict[str, str]) -> Dict[str, str]:
+    """The keywords of request ``stem`` that take an SI value with a probe, by their Python
+    name, and their dimension (``x-dim``): ``@_typed(si=...)`` reads their text with a unit."""
+    props = json.loads((SCHEMAS / f"{stem}.json").read_text()).get("properties", {})
+    return {{"from": "from_", **rename}.get(k, k): p["x-dim"] for k, p in props.items()
+            if p.get("x-dim") in SI_DIMS}
+
+
+def _decorator(opts: Dict[str, object], dims: Dict[str, str]) -> List[str]:
+    """``@_typed``, with the SI keywords' dimensions where the function has some."""
+    if not opts.get("typed", True):
+        return []
+    if not dims:
+        return ["@_typed"]
+    return ["@_typed(si={" + ", ".join(f'"{k}": "{v}"' for k, v in dims.items()) + "})"]
+
+
 def _function(file: str, name: str) -> str:
     stem, module, returns, opts = FILES[file][name]
     omit, override = tuple(opts.get("omit", ())), dict(opts.get("override", {}))  # type: ignore
@@ -340,7 +361,10 @@ def _function(file: str, name: str) -> str:
                 and (LAYOUTS / f"{name}.json").exists():
             body += [""] + ["    " + t if t else "" for t in _layout_tables(name, doc)]
     text = textwrap.indent("\n".join(body), "    ").replace("\n    \n", "\n\n")
-    lines = (["@_typed"] if opts.get("typed", True) else []) + [
+    taken = {{"from": "from_", **rename}.get(f[0], f[0]) for f in fields} | {
+        k for k, _, _ in positional}
+    dims = {k: v for k, v in (_dims(str(stem), rename) if stem else {}).items() if k in taken}
+    lines = _decorator(opts, dims) + [
         f"def {name}(", *sig, f") -> {returns}:", f'    """{text.strip()}', '    """',
         f"    return {module}._finish_{name}(locals())"]
     return "\n".join(line.rstrip() for line in lines)

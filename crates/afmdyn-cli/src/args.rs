@@ -280,171 +280,51 @@ impl ModelArgs {
     }
 }
 
-/// What an SI unit suffix measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Dim {
-    /// m, mm, µm (um), nm, pm.
-    Length,
-    /// Hz, kHz, MHz.
-    Frequency,
-    /// N, mN, µN (uN), nN, pN.
-    Force,
+pub use afmdyn::request::quantity::{Dim, Quantity};
+
+/// The value of flag `--flag` ([`Quantity::si`]), which takes `want` in SI when `si` (with a
+/// probe), else a dimensionless number.
+///
+/// # Errors
+/// [`CliError::Input`] for a unit of another dimension, or a unit without a probe.
+pub fn flag_value(q: Quantity, flag: &str, want: Dim, si: bool) -> Result<f64, CliError> {
+    q.si(&format!("--{flag}"), "--probe", want, si)
+        .map_err(CliError::Input)
 }
 
-impl Dim {
-    /// Its SI unit.
-    fn unit(self) -> &'static str {
-        match self {
-            Dim::Length => "m",
-            Dim::Frequency => "Hz",
-            Dim::Force => "N",
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Dim::Length => "a length (m)",
-            Dim::Frequency => "a frequency (Hz)",
-            Dim::Force => "a force (N)",
-        }
-    }
-}
-
-/// A number as a user writes it, with an optional SI unit: `20nm`, `20 nm`, `0.1nm`,
-/// `300kHz`, `-3e-9` (the value in the base unit, m or Hz, and the unit's dimension).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quantity {
-    /// The value in m or Hz when a unit was written, else as written.
-    pub value: f64,
-    /// The unit's dimension, when a unit was written.
-    pub dim: Option<Dim>,
-}
-
-/// The SI units a number may carry on the command line, with their powers of ten to m or Hz.
-const UNITS: [(&str, i32, Dim); 15] = [
-    ("pm", -12, Dim::Length),
-    ("nm", -9, Dim::Length),
-    ("um", -6, Dim::Length),
-    ("µm", -6, Dim::Length),
-    ("mm", -3, Dim::Length),
-    ("m", 0, Dim::Length),
-    ("kHz", 3, Dim::Frequency),
-    ("MHz", 6, Dim::Frequency),
-    ("Hz", 0, Dim::Frequency),
-    ("pN", -12, Dim::Force),
-    ("nN", -9, Dim::Force),
-    ("uN", -6, Dim::Force),
-    ("µN", -6, Dim::Force),
-    ("mN", -3, Dim::Force),
-    ("N", 0, Dim::Force),
-];
-
-impl std::str::FromStr for Quantity {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let t = s.trim();
-        if let Ok(v) = t.parse::<f64>() {
-            return Ok(Quantity {
-                value: v,
-                dim: None,
-            });
-        }
-        for (unit, exp, dim) in UNITS {
-            if let Some(num) = t.strip_suffix(unit).map(str::trim_end) {
-                if let Ok(v) = num.parse::<f64>() {
-                    // `7nm` reads as `7e-9` exactly (7 × 1e-9 would be one ulp off)
-                    let value = if num.contains(['e', 'E']) {
-                        v * 10f64.powi(exp)
-                    } else {
-                        format!("{num}e{exp}")
-                            .parse()
-                            .unwrap_or(v * 10f64.powi(exp))
-                    };
-                    return Ok(Quantity {
-                        value,
-                        dim: Some(dim),
-                    });
-                }
-            }
-        }
-        Err(format!(
-            "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz, pN, nN, uN, mN, N)"
-        ))
-    }
-}
-
-/// A plain number (a request's default): no unit.
-impl From<f64> for Quantity {
-    fn from(value: f64) -> Self {
-        Quantity { value, dim: None }
-    }
-}
-
-/// As written without a unit (the `[default: …]` of `--help`: `3.0`, as a number's `Debug`).
-impl std::fmt::Display for Quantity {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{:?}", self.value)
-    }
-}
-
-impl Quantity {
-    /// The value of flag `--flag`, which takes `want` in SI when `si` (with a probe), else a
-    /// dimensionless number.
-    ///
-    /// # Errors
-    /// [`CliError::Input`] for a unit of another dimension, or a unit without a probe.
-    pub fn value(self, flag: &str, want: Dim, si: bool) -> Result<f64, CliError> {
-        match self.dim {
-            Some(d) if d != want => Err(CliError::Input(format!(
-                "--{flag}: the unit makes it {}, but --{flag} takes {}",
-                d.name(),
-                want.name()
-            ))),
-            Some(_) if !si => Err(CliError::Input(format!(
-                "--{flag}: a value with a unit needs --probe (without one, --{flag} is \
-                 dimensionless: g0 or Ω)"
-            ))),
-            _ => Ok(self.value),
-        }
-    }
-}
-
-/// `Option<Quantity>` → its value ([`Quantity::value`]).
+/// `Option<Quantity>` → its value ([`flag_value`]).
 pub fn quantity(
     q: Option<Quantity>,
     flag: &str,
     want: Dim,
     si: bool,
 ) -> Result<Option<f64>, CliError> {
-    q.map(|q| q.value(flag, want, si)).transpose()
+    q.map(|q| flag_value(q, flag, want, si)).transpose()
 }
 
-impl Quantity {
-    /// The value of flag `--flag` whose dimension the command's mode gives: `want` as in
-    /// [`Quantity::value`], or `None` for a plain number (a ratio), which takes no unit.
-    ///
-    /// # Errors
-    /// [`CliError::Input`] as [`Quantity::value`], or for a unit where the mode takes a plain
-    /// number.
-    pub fn value_in(self, flag: &str, want: Option<Dim>, si: bool) -> Result<f64, CliError> {
-        match (want, self.dim) {
-            (Some(want), _) => self.value(flag, want, si),
-            (None, Some(d)) => Err(CliError::Input(format!(
-                "--{flag}: the unit makes it {}, but here --{flag} is a plain number \
+/// The value of flag `--flag` whose dimension the command's mode gives: `want` as in
+/// [`flag_value`], or `None` for a plain number (a ratio), which takes no unit.
+///
+/// # Errors
+/// [`CliError::Input`] as [`flag_value`], or for a unit where the mode takes a plain number.
+pub fn value_in(q: Quantity, flag: &str, want: Option<Dim>, si: bool) -> Result<f64, CliError> {
+    match (want, q.dim) {
+        (Some(want), _) => flag_value(q, flag, want, si),
+        (None, Some(d)) => Err(CliError::Input(format!(
+            "--{flag}: the unit makes it {}, but here --{flag} is a plain number \
                  (a ratio, without a unit)",
-                d.name()
-            ))),
-            (None, None) => Ok(self.value),
-        }
+            d.name()
+        ))),
+        (None, None) => Ok(q.value),
     }
 }
 
 /// The values of a comma-separated flag `--flag` of exactly `N` quantities of dimension
-/// `want` ([`Quantity::value`]), e.g. `--range LO,HI` (`names`: its value name, `LO,HI`).
+/// `want` ([`flag_value`]), e.g. `--range LO,HI` (`names`: its value name, `LO,HI`).
 ///
 /// # Errors
 /// [`CliError::Input`] naming the flag for another number of values, or as
-/// [`Quantity::value`].
+/// [`flag_value`].
 pub fn values<const N: usize>(
     q: Option<&[Quantity]>,
     flag: &str,
@@ -459,7 +339,7 @@ pub fn values<const N: usize>(
     }
     let mut out = [0.0; N];
     for (o, v) in out.iter_mut().zip(q) {
-        *o = v.value(flag, want, si)?;
+        *o = flag_value(*v, flag, want, si)?;
     }
     Ok(Some(out))
 }
@@ -527,42 +407,5 @@ pub fn probe_text(
     match medium {
         None => Ok(text),
         Some(name) => afmdyn::hydro::with_medium(&text, name).map_err(bad),
-    }
-}
-
-#[cfg(test)]
-mod quantity_tests {
-    use super::{Dim, Quantity};
-
-    #[test]
-    fn numbers_read_with_and_without_units() {
-        let q = |s: &str| s.parse::<Quantity>().unwrap();
-        assert_eq!(
-            q("7nm"),
-            Quantity {
-                value: 7e-9,
-                dim: Some(Dim::Length)
-            }
-        );
-        assert_eq!(
-            q(" 0.5 nm "),
-            Quantity {
-                value: 0.5e-9,
-                dim: Some(Dim::Length)
-            }
-        );
-        assert_eq!(
-            q("-3e-9"),
-            Quantity {
-                value: -3e-9,
-                dim: None
-            }
-        );
-        assert_eq!(q("300kHz").value, 300e3);
-        assert_eq!(q("1.2MHz").value, 1.2e6);
-        assert_eq!(q("2e1nm").value, 20e-9);
-        assert_eq!(q("5µm").value, 5e-6);
-        assert!("7 parsecs".parse::<Quantity>().is_err());
-        assert!("nm".parse::<Quantity>().is_err());
     }
 }

@@ -54,7 +54,7 @@ fn axis_value(q: Quantity, flag: &str, axis: &str) -> Result<f64, CliError> {
                 u => format!("in {u}"),
             }
         ))),
-        (_, Some(d)) => q.value(flag, d, true),
+        (_, Some(d)) => crate::args::flag_value(q, flag, d, true),
         (None, None) => Ok(q.value),
     }
 }

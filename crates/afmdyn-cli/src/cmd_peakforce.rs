@@ -73,7 +73,7 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
                 PeakForceSweepParam::ZC => Dim::Length,
                 PeakForceSweepParam::ModulationFrequency => Dim::Frequency,
             };
-            let v = |q: Quantity, flag: &str| q.value(flag, dim, si);
+            let v = |q: Quantity, flag: &str| crate::args::flag_value(q, flag, dim, si);
             let values = PeakForceSweep::grid(v(from, "from")?, v(to, "to")?, v(step, "step")?)?;
             Some(PeakForceSweep {
                 quantity: param,

@@ -35,7 +35,7 @@ impl ImageFlags {
             curve_points: self.curve_points.unwrap_or(120),
             lines: self.lines,
             pixels: self.pixels,
-            setpoint: self.setpoint.value_in("setpoint", mode_dim, si)?,
+            setpoint: crate::args::value_in(self.setpoint, "setpoint", mode_dim, si)?,
         })
     }
 }

@@ -35,6 +35,33 @@ fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyA
     convert::json_to_py(py, &d.to_string())
 }
 
+/// The value of keyword `name` written as text with an SI unit (`"95nm"`, `"0.5 nN"`): its value
+/// in SI ([`afmdyn::request::quantity::Quantity::si`]); `want` is the keyword's dimension (its
+/// schema's `x-dim`: `"length"`, `"frequency"` or `"force"`), `si` whether the call has a probe.
+///
+/// # Errors
+/// `ValueError` naming the keyword for text that is no number with a unit, a unit of another
+/// dimension or a unit without a probe; `TypeError` for a number written as text without a
+/// unit (`"40"`: give the number).
+#[pyfunction]
+fn si_value(text: &str, name: &str, want: &str, si: bool) -> PyResult<f64> {
+    use afmdyn::request::quantity::{Dim, Quantity};
+    use pyo3::exceptions::{PyTypeError, PyValueError};
+    let want = Dim::of_key(want)
+        .ok_or_else(|| PyValueError::new_err(format!("{name}: takes no unit (got {text:?})")))?;
+    let q: Quantity = text
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("{name} = {e}")))?;
+    if q.dim.is_none() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: must be a number, or text with a unit of {} such as '95nm', got str {text:?}",
+            want.name()
+        )));
+    }
+    q.si(name, "probe=", want, si)
+        .map_err(PyValueError::new_err)
+}
+
 /// Compiled core of afmdyn (use the `afmdyn` package, not this module).
 #[pymodule]
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -52,6 +79,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(door::run_stored, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(si_value, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::read_height_map, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::setpoint_study, m)?)?;

@@ -6,6 +6,7 @@ result type, so that every module of the package can import it."""
 
 from __future__ import annotations
 
+import collections.abc
 import functools
 import inspect
 import json
@@ -13,7 +14,8 @@ import numbers
 import os
 import sys
 import warnings
-from typing import Any, Callable, Dict, Optional, Protocol, Sequence, Tuple, TypeVar, Union, cast
+from typing import (Any, Callable, Dict, Optional, Protocol, Sequence, Tuple, TypeVar, Union, cast,
+                    overload)
 
 import numpy as np
 import xarray as xr
@@ -146,52 +148,139 @@ _KINDS: Dict[str, Tuple[Any, str]] = {
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
+#: the annotations of the sequence keywords ``_typed`` checks: (element kind, optional, a
+#: single number taken too)
+_SEQUENCES: Dict[str, Tuple[str, bool, bool]] = {
+    "Sequence[float]": ("float", False, False),
+    "Optional[Sequence[float]]": ("float", True, False),
+    "Optional[Tuple[float, float]]": ("float", True, False),
+    "Sequence[str]": ("str", False, False),
+    "Optional[Sequence[str]]": ("str", True, False),
+    "Union[float, Sequence[float], None]": ("float", True, True),
+}
 
-def _typed(f: _F) -> _F:
+
+@overload
+def _typed(f: _F) -> _F: ...
+
+
+@overload
+def _typed(f: None = None, *, si: Dict[str, str]) -> Callable[[_F], _F]: ...
+
+
+def _typed(f: Optional[_F] = None, *, si: Optional[Dict[str, str]] = None) -> Any:
     """Check the keywords of the public function ``f`` against its annotations before any
-    work: ``int``/``float``/``bool``/``str`` and their ``Optional[...]``. A wrong type is a
-    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits (or, for a
-    ``float`` keyword, beyond a double's range) a ``ValueError`` naming it (the core's
-    conversions would say neither)."""
+    work: ``int``/``float``/``bool``/``str``, their ``Optional[...]`` and the sequences of
+    :data:`_SEQUENCES`. A wrong type is a ``TypeError`` naming the keyword and what it takes
+    (a string is never read as a sequence of characters); an integer beyond 64 bits (or, for
+    a ``float`` keyword, beyond a double's range) a ``ValueError`` naming it (the core's
+    conversions would say neither). ``si`` names the keywords that take an SI value with a
+    probe and their dimension (the request schema's ``x-dim``: ``"length"``, ``"force"``,
+    ``"frequency"``): they take text with a unit too (``z_c="95nm"``), read by the library
+    (``_afmdyn.si_value``: a unit of another dimension, or a unit without ``probe=``, is a
+    ``ValueError`` naming the keyword). Used as ``@_typed`` or ``@_typed(si={...})``."""
+    if f is None:
+        return functools.partial(_typed, si=si)
+    dims = dict(si or {})
     sig = inspect.signature(f)
     checks: Dict[str, Tuple[str, bool]] = {}
+    sequences: Dict[str, Tuple[str, bool, bool]] = {}
     for name, prm in sig.parameters.items():
         ann = prm.annotation if isinstance(prm.annotation, str) else ""
         optional = ann.startswith("Optional[") and ann.endswith("]")
         base = ann[len("Optional["):-1] if optional else ann
         if base in _KINDS:
             checks[name] = (base, optional)
+        elif ann in _SEQUENCES:
+            sequences[name] = _SEQUENCES[ann]
+    # a function without model keywords takes SI values (a fit, a reconstruction, an image)
+    model = next((p.name for p in sig.parameters.values() if p.kind is p.VAR_KEYWORD), None)
 
     @functools.wraps(f)
     def checked(*args: Any, **kwargs: Any) -> Any:
-        for name, value in sig.bind_partial(*args, **kwargs).arguments.items():
-            if name not in checks:
-                continue
-            base, optional = checks[name]
-            if value is None and optional:
-                continue
-            kind, what = _KINDS[base]
-            numeric_bool = base in ("int", "float") and isinstance(value, (bool, np.bool_))
-            if numeric_bool or not isinstance(value, kind):
-                takes = what + (" or None" if optional else "")
-                raise TypeError(
-                    f"{f.__name__}(): {name} must be {takes}, got {type(value).__name__} {value!r}"
-                )
-            if base == "int" and not -(2**63) <= int(value) < 2**63:
-                raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
-            if base == "float" and isinstance(value, numbers.Integral):
-                # float(10**400) raises OverflowError: a number out of range is a ValueError
-                try:
-                    float(value)
-                except OverflowError:
-                    digits = len(str(abs(int(value))))
-                    raise ValueError(
-                        f"{name} = an integer of {digits} digits: must be a finite number "
-                        "(far beyond every limit)"
-                    ) from None
-        return f(*args, **kwargs)
+        bound = sig.bind_partial(*args, **kwargs)
+        given = bound.arguments
+        with_probe = model is None or (given.get(model) or {}).get("probe") is not None
+        for name in list(given):
+            dim = dims.get(name)
+            if name in checks:
+                given[name] = _checked_scalar(f.__name__, name, given[name], checks[name],
+                                              dim, with_probe)
+            elif name in sequences:
+                given[name] = _checked_sequence(f.__name__, name, given[name], sequences[name],
+                                                dim, with_probe)
+        return f(*bound.args, **bound.kwargs)
 
     return cast(_F, checked)
+
+
+def _si(name: str, value: Any, dim: Optional[str], with_probe: bool) -> Any:
+    """``value``, or its SI value where it is text with a unit for a keyword of dimension
+    ``dim`` (``_afmdyn.si_value``)."""
+    if dim is not None and isinstance(value, str):
+        return _core.si_value(value, name, dim, with_probe)
+    return value
+
+
+def _checked_scalar(fn: str, name: str, value: Any, kind: Tuple[str, bool],
+                    dim: Optional[str], with_probe: bool) -> Any:
+    """``value`` of keyword ``name`` of ``fn`` checked against its kind (:func:`_typed`)."""
+    base, optional = kind
+    if value is None and optional:
+        return value
+    value = _si(name, value, dim, with_probe)
+    cls, what = _KINDS[base]
+    numeric_bool = base in ("int", "float") and isinstance(value, (bool, np.bool_))
+    if numeric_bool or not isinstance(value, cls):
+        if dim is not None:
+            what += " or text with a unit such as '95nm'"
+        takes = what + (" or None" if optional else "")
+        raise TypeError(f"{fn}(): {name} must be {takes}, got {type(value).__name__} {value!r}")
+    if base == "int" and not -(2**63) <= int(value) < 2**63:
+        raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
+    if base == "float" and isinstance(value, numbers.Integral):
+        # float(10**400) raises OverflowError: a number out of range is a ValueError
+        try:
+            float(value)
+        except OverflowError:
+            digits = len(str(abs(int(value))))
+            raise ValueError(
+                f"{name} = an integer of {digits} digits: must be a finite number "
+                "(far beyond every limit)"
+            ) from None
+    return value
+
+
+def _checked_sequence(fn: str, name: str, value: Any, kind: Tuple[str, bool, bool],
+                      dim: Optional[str], with_probe: bool) -> Any:
+    """``value`` of the sequence keyword ``name`` of ``fn`` checked (:func:`_typed`): a
+    sequence (or NumPy array) of numbers (text with a unit where ``dim`` says) or of names,
+    never a string read as its characters; a single number where ``kind`` takes one."""
+    element, optional, single = kind
+    if value is None and optional:
+        return value
+    numbers_ = element == "float"
+    what = ("a sequence of numbers" if numbers_ else "a sequence of names such as ['E']") + (
+        ", or a number" if single else "") + (" or None" if optional else "")
+    if single and (isinstance(value, str) or isinstance(value, numbers.Real)):
+        return _checked_scalar(fn, name, value, ("float", optional), dim, with_probe)
+    if isinstance(value, np.ndarray) and numbers_:
+        # an array of numbers goes on as it is: its dimensions, and a complex array, are the
+        # finisher's to refuse (``_real_array``: a ValueError naming them)
+        if value.dtype.kind not in "iufc":
+            raise TypeError(f"{fn}(): {name} must be {what}, got an array of {value.dtype}")
+        return value
+    if isinstance(value, (str, bytes, collections.abc.Mapping)) or \
+            not isinstance(value, collections.abc.Iterable):
+        raise TypeError(f"{fn}(): {name} must be {what}, got {type(value).__name__} {value!r}")
+    items = [_si(name, v, dim, with_probe) for v in value]
+    for v in items:
+        ok = (isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))) \
+            if numbers_ else isinstance(v, str)
+        if not ok:
+            raise TypeError(f"{fn}(): {name} must be {what}, got an item "
+                            f"{type(v).__name__} {v!r}")
+    return items
 
 
 class AfmdynWarning(UserWarning):

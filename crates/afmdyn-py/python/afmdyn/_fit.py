@@ -28,6 +28,7 @@ def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
         request["fit"] = list(fit)
     if fit_range is not None:
         request["range"] = [float(fit_range[0]), float(fit_range[1])]
+    _check_data(a["data"])
     data, k_file, segments = _instrument_curve(a["data"], a["curve"])
     if approach_rows is None:
         approach_rows = segments
@@ -74,6 +75,15 @@ def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
 
 # the instrument formats read through afmformats (its ``supported_extensions`` without the
 # plain-text ones, which are afmdyn's own CSV here)
+def _check_data(data: Any) -> None:
+    """A ``TypeError`` naming ``data`` for what is no curve: a path, a mapping of columns or a
+    table with columns (pandas, afmformats) is one."""
+    if data is None or isinstance(data, (str, os.PathLike, Mapping)) or hasattr(data, "columns"):
+        return
+    raise TypeError(f"fit(): data must be a path, a mapping of columns (height, force, …) or a "
+                    f"table with columns (pandas, afmformats), got {type(data).__name__} {data!r}")
+
+
 _AFMFORMATS = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw", ".h5",
                ".tab", ".zip")
 # the largest instrument file read (a JPK force map of 128 × 128 curves is ~ 0.5 GiB)

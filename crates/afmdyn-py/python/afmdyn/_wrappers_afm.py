@@ -565,7 +565,7 @@ def resonance(
     return _api._finish_resonance(locals())
 
 
-@_typed
+@_typed(si={"amplitude": "length", "from_": "length", "step": "length", "to": "length"})
 def fm(
     params: Optional[Params] = None,
     /,
@@ -646,6 +646,7 @@ def fm(
     return _fm._finish_fm(locals())
 
 
+@_typed(si={"filter_cutoff": "frequency", "setpoint": "force", "z_c": "length"})
 def peakforce(
     params: Optional[Params] = None,
     /,
@@ -739,6 +740,7 @@ def peakforce(
     return _peakforce._finish_peakforce(locals())
 
 
+@_typed(si={"fit_range": "length"})
 def fit(
     params: Optional[Params] = None,
     /,
@@ -1048,6 +1050,7 @@ def setpoint_study(
     return _image._finish_setpoint_study(locals())
 
 
+@_typed(si={"amplitude": "length", "resonance_frequency": "frequency"})
 def reconstruct(
     *,
     amplitude: Optional[float] = None,

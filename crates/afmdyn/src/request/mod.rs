@@ -61,6 +61,7 @@ pub mod named;
 pub mod peakforce;
 pub(crate) mod peakforce_sweep;
 pub(crate) mod pool;
+pub mod quantity;
 
 pub mod reconstruct;
 pub(crate) mod reconstruct_document;

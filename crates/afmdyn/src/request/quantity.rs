@@ -1,0 +1,184 @@
+//! A number as a user writes it, with an optional SI unit ([`Quantity`]: `20nm`, `300kHz`,
+//! `0.5 nN`, `-3e-9`), and what its unit measures ([`Dim`]): the one reader of such numbers, for
+//! the command line's flags (`--z-c 20nm`) and Python's keywords (`z_c="20nm"`). A keyword
+//! that takes an SI value with a probe takes a dimensionless one without (g₀, Ω, F̃), so a
+//! unit without a probe is refused ([`Quantity::si`]).
+
+/// What an SI unit suffix measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dim {
+    /// m, mm, µm (um), nm, pm.
+    Length,
+    /// Hz, kHz, MHz.
+    Frequency,
+    /// N, mN, µN (uN), nN, pN.
+    Force,
+}
+
+impl Dim {
+    /// The dimension a request schema names in a field's `x-dim` (`"length"`, `"frequency"`,
+    /// `"force"`), or `None` for another key.
+    pub fn of_key(key: &str) -> Option<Dim> {
+        match key {
+            "length" => Some(Dim::Length),
+            "frequency" => Some(Dim::Frequency),
+            "force" => Some(Dim::Force),
+            _ => None,
+        }
+    }
+
+    /// Its SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Dim::Length => "m",
+            Dim::Frequency => "Hz",
+            Dim::Force => "N",
+        }
+    }
+
+    /// What it measures, with its SI unit: `a length (m)`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dim::Length => "a length (m)",
+            Dim::Frequency => "a frequency (Hz)",
+            Dim::Force => "a force (N)",
+        }
+    }
+}
+
+/// A number as a user writes it, with an optional SI unit: `20nm`, `20 nm`, `0.1nm`,
+/// `300kHz`, `-3e-9` (the value in the base unit, m, Hz or N, and the unit's dimension).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quantity {
+    /// The value in m, Hz or N when a unit was written, else as written.
+    pub value: f64,
+    /// The unit's dimension, when a unit was written.
+    pub dim: Option<Dim>,
+}
+
+/// The SI units a number may carry, with their powers of ten to m, Hz or N.
+const UNITS: [(&str, i32, Dim); 15] = [
+    ("pm", -12, Dim::Length),
+    ("nm", -9, Dim::Length),
+    ("um", -6, Dim::Length),
+    ("µm", -6, Dim::Length),
+    ("mm", -3, Dim::Length),
+    ("m", 0, Dim::Length),
+    ("kHz", 3, Dim::Frequency),
+    ("MHz", 6, Dim::Frequency),
+    ("Hz", 0, Dim::Frequency),
+    ("pN", -12, Dim::Force),
+    ("nN", -9, Dim::Force),
+    ("uN", -6, Dim::Force),
+    ("µN", -6, Dim::Force),
+    ("mN", -3, Dim::Force),
+    ("N", 0, Dim::Force),
+];
+
+impl std::str::FromStr for Quantity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim();
+        if let Ok(v) = t.parse::<f64>() {
+            return Ok(Quantity {
+                value: v,
+                dim: None,
+            });
+        }
+        for (unit, exp, dim) in UNITS {
+            if let Some(num) = t.strip_suffix(unit).map(str::trim_end) {
+                if let Ok(v) = num.parse::<f64>() {
+                    // `7nm` reads as `7e-9` exactly (7 × 1e-9 would be one ulp off)
+                    let value = if num.contains(['e', 'E']) {
+                        v * 10f64.powi(exp)
+                    } else {
+                        format!("{num}e{exp}")
+                            .parse()
+                            .unwrap_or(v * 10f64.powi(exp))
+                    };
+                    return Ok(Quantity {
+                        value,
+                        dim: Some(dim),
+                    });
+                }
+            }
+        }
+        Err(format!(
+            "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz, pN, nN, uN, mN, N)"
+        ))
+    }
+}
+
+/// A plain number (a request's default): no unit.
+impl From<f64> for Quantity {
+    fn from(value: f64) -> Self {
+        Quantity { value, dim: None }
+    }
+}
+
+/// As written without a unit (the `[default: …]` of `--help`: `3.0`, as a number's `Debug`).
+impl std::fmt::Display for Quantity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.value)
+    }
+}
+
+impl Quantity {
+    /// The value of the keyword `name` (as a front end spells it: `--z-c`, `z_c`), which takes
+    /// `want` in SI when `si` (with a probe, `probe` as the front end spells it: `--probe`,
+    /// `probe=`), else a dimensionless number.
+    ///
+    /// # Errors
+    /// A message naming `name` for a unit of another dimension, or a unit without a probe.
+    pub fn si(self, name: &str, probe: &str, want: Dim, si: bool) -> Result<f64, String> {
+        match self.dim {
+            Some(d) if d != want => Err(format!(
+                "{name}: the unit makes it {}, but {name} takes {}",
+                d.name(),
+                want.name()
+            )),
+            Some(_) if !si => Err(format!(
+                "{name}: a value with a unit needs {probe} (without one, {name} is \
+                 dimensionless: g0 or Ω)"
+            )),
+            _ => Ok(self.value),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Dim, Quantity};
+
+    #[test]
+    fn numbers_read_with_and_without_units() {
+        let q = |s: &str| s.parse::<Quantity>().unwrap();
+        assert_eq!(
+            q("7nm"),
+            Quantity {
+                value: 7e-9,
+                dim: Some(Dim::Length)
+            }
+        );
+        assert_eq!(
+            q(" 0.5 nm "),
+            Quantity {
+                value: 0.5e-9,
+                dim: Some(Dim::Length)
+            }
+        );
+        assert_eq!(
+            q("-3e-9"),
+            Quantity {
+                value: -3e-9,
+                dim: None
+            }
+        );
+        assert_eq!(q("300kHz").value, 300e3);
+        assert_eq!(q("1.2MHz").value, 1.2e6);
+        assert_eq!(q("2e1nm").value, 20e-9);
+        assert_eq!(q("5µm").value, 5e-6);
+        assert!("7 parsecs".parse::<Quantity>().is_err());
+        assert!("nm".parse::<Quantity>().is_err());
+    }
+}
