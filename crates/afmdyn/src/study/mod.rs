@@ -44,6 +44,9 @@ pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
+pub(crate) mod fit;
+pub(crate) mod fit_dynamic;
+pub(crate) mod fm;
 pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
@@ -52,6 +55,7 @@ pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
+pub(crate) mod reconstruct;
 pub mod scan;
 #[cfg(feature = "files")]
 pub(crate) mod scan_store;
