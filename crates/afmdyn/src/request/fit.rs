@@ -113,6 +113,7 @@ impl Default for FitRequest {
 /// A force curve's columns: heights, forces, their σ and the rows' times.
 type Columns = (Vec<f64>, Vec<f64>, Option<Vec<f64>>, Option<Vec<f64>>);
 
+/// A refusal naming `name`.
 pub(crate) fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
 }

@@ -10,9 +10,8 @@
 //! the drive's second component (optional `sigma_amplitude_2`, `sigma_phase_2`), with or
 //! without `amplitude` and `phase`, under a probe whose drive has a second component
 //! ([`crate::analysis::fit::bimodal_curve`]). The request is [`super::FitRequest`] (the
-//! data's columns choose the kind: `z` makes it dynamic); its document has the force-curve
-//! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
-//! curve beside the data with its residuals, warnings).
+//! data's columns choose the kind: `z` makes it dynamic). Here its data are read and checked,
+//! the parameters a law, lever or drive refuses named, and its cost declared.
 
 pub(crate) use super::fit_result::AmData;
 use super::fit_result::{probe_value, MIN_FIT_ROWS};
@@ -20,6 +19,7 @@ use crate::analysis::fit::am_curve::{AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::profile::MAX_SECANT_STEPS;
 use crate::error::SimError;
 
+/// A refusal naming `name`.
 pub(crate) fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
 }
@@ -66,6 +66,8 @@ pub(crate) fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimErro
     Ok(None)
 }
 
+/// Check an AM, FM or bimodal curve's columns: one channel at least, their rows, finite values,
+/// σ > 0 and the σ columns that channels fitted together need.
 pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
     let m = d.z.len();
     let bimodal = d.amplitude_2.is_some() || d.phase_2.is_some();

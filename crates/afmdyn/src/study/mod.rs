@@ -31,6 +31,10 @@
 //!   `peakforce` (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
 //!   sweep's points, its branches continued across them, stored in its checkpoint). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
+//! - the running of the requests that are one computation (their `Analysis`: execution,
+//!   document, presentation, layouts), beside the requests in [`crate::request`]: `fit` and
+//!   `fit_dynamic` (a force curve's and a dynamic curve's fit), `fm` (an FM curve) and
+//!   `reconstruct` (the force behind an FM or AM curve, and `reconstruct_document`'s run).
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
