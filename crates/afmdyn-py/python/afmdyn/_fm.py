@@ -1,6 +1,6 @@
 """The constant-amplitude FM-AFM curve (``afmdyn fm``): the library's exact periodic orbits
 under an ideal PLL and amplitude controller as an ``xarray.Dataset``, built from the library's
-layout (``request::fm::layout``) and document (no numerics here)."""
+layout (``study::fm::layout``) and document (no numerics here)."""
 
 from __future__ import annotations
 

@@ -1,15 +1,15 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
-//! The stepped curves' layouts are laid out from their documents; `fm`'s is
-//! [`super::fm::layout`], `reconstruct`'s [`super::reconstruct::layout`].
+//! The stepped curves' layouts are laid out from their documents (`fm`'s and `reconstruct`'s
+//! where they run).
 
 use super::modes::ModesRequest;
 use super::named::Datasets;
 use super::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
 use super::BasinArrays;
 use super::{
-    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,
-    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, ReconstructRequest,
+    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
+    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
 };
 use crate::analysis::steady::SteadyState;
 use crate::eigen::RegionSpectrum;
@@ -334,21 +334,6 @@ impl Datasets for ResonanceRequest {
     }
 }
 
-impl Datasets for FmRequest {
-    /// The curve's layout `fm` (`super::fm::layout`).
-    fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        one("fm", super::fm::layout(model, curve))
-    }
-}
-
-impl Datasets for ReconstructRequest {
-    /// The reconstruction's layout `reconstruct` (`super::reconstruct::layout`, with the
-    /// request's `law_force`).
-    fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
-        let layout = super::reconstruct::layout(r, self.law_in_order());
-        one("reconstruct", layout)
-    }
-}
 impl Datasets for Bimodal {
     fn datasets(
         &self,

@@ -1,23 +1,20 @@
 //! `fm`: the frequency-modulation (FM-AFM) curve at constant amplitude over the rest distance
 //! z_c ([`crate::analysis::fm`]: ideal PLL and amplitude controller, exact periodic orbits) —
-//! the request the command line (`afmdyn fm`) and Python (`afmdyn.fm`) share, and its
-//! document. With a probe everything is SI (z_c and A in m, Δf in Hz, E_dis in J, forces in N);
+//! the request the command line (`afmdyn fm`) and Python (`afmdyn.fm`) share: its options,
+//! their defaults, ranges and checks, and its declared cost. With a probe everything is SI (z_c and A in m, Δf in Hz, E_dis in J, forces in N);
 //! without one the model's units (g₀, Ω, F̃).
 
 use super::costs::{newton_work, state_bytes, MODEL_BYTES};
 use super::curves::CurveRequest;
 use super::limits::Cost;
-use super::run::{Analysis, Request, Resolved};
+use super::run::{Request, Resolved};
 use crate::analysis::approach::approach_spec;
+use crate::analysis::fm::FmSpec;
 use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
-use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference, FmSpec};
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
-use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::layout::columns::{self, columns, Column, UnitNames};
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
 
 /// `fm`: an FM curve from `from` to `to` (z_c; m with a probe, else g₀) at the oscillation
 /// amplitude `amplitude`, tracking mode `mode`.
@@ -254,195 +251,4 @@ impl Request for FmRequest {
             work: points * steps * newton_work(p, 1, &spec.newton),
         })
     }
-}
-
-impl Analysis for FmRequest {
-    type Output = FmCurve;
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
-        super::curves::check_single_frequency(&model.params, "fm")?;
-        fm_curve(&self.spec(model)?, progress)
-    }
-    fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
-        Ok(document(self, model, curve))
-    }
-    fn present(
-        &self,
-        curve: &FmCurve,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = at.document.clone();
-        let table = table(at.model, curve);
-        let mut shown = crate::report::present::fm::fm(&mut document, table, at.units, at.to);
-        shown.document = Some(document);
-        Ok(shown)
-    }
-    fn largest_indentation(&self, curve: &FmCurve) -> Option<f64> {
-        let d = curve.points.iter().map(|q| q.observables.indentation);
-        Some(d.filter(|d| d.is_finite()).fold(0.0, f64::max))
-    }
-}
-
-/// What an FM point's columns ([`COLUMNS`]) are read through: the document's units, Hz per
-/// unit Ω (1 without a probe), the free lever's operating point and the model (z_c from α5).
-struct Frame {
-    u: CurveUnits,
-    hz: f64,
-    reference: FmReference,
-    base: crate::Params,
-}
-
-impl Frame {
-    fn new(model: &Resolved, curve: &FmCurve) -> Frame {
-        let u = FmRequest::units(model);
-        Frame {
-            u,
-            hz: u.hz_per_omega.unwrap_or(1.0),
-            reference: curve.reference,
-            base: model.params,
-        }
-    }
-
-    /// The rest distance at α5 = `a5` in the document's length unit.
-    fn z_c(&self, a5: f64) -> f64 {
-        self.base
-            .with(crate::params::SweepParam::Alpha5, a5)
-            .rest_distance()
-            * self.u.length
-    }
-}
-
-/// The columns of an FM curve, one entry per z_c reached: the document's `curve` arrays (and
-/// the units its `units` names: those `true`), the layout's variables over `z_c` and the table
-/// `fm.csv`, in this order.
-const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
-    "z_c", Length, true, "rest distance z_c", F64(|f, q| f.z_c(q.alpha5));
-    "frequency_shift", Own("Hz", "Ω (units of the τ scale)"), true,
-        "frequency shift Δf = f − f_K", F64(|f, q| (q.omega - f.reference.omega) * f.hz);
-    "frequency", Frequency, true, "drive frequency the PLL locks at", F64(|f, q| q.omega * f.hz);
-    "excitation", Own("1 (relative to the free lever's at its resonance)", "1 (relative)"), true,
-        "excitation relative to the free lever's at its resonance",
-        F64(|f, q| q.alpha2 / f.reference.excitation);
-    "amplitude", Length, true, "first-harmonic amplitude A1",
-        F64(|f, q| q.observables.amplitude * f.u.length);
-    "phase_deg", Fixed("deg"), false, "lag of the first harmonic behind the drive",
-        F64(|_, q| q.observables.phase.to_degrees());
-    "energy_dissipated", Energy, true, "energy dissipated in the sample per cycle",
-        F64(|f, q| q.observables.energy_dissipated * f.u.energy);
-    "virial", Energy, true, "virial ⟨F_c W⟩", F64(|f, q| q.observables.virial * f.u.energy);
-    "mean_deflection", Length, false, "mean deflection",
-        F64(|f, q| q.observables.mean_deflection * f.u.length);
-    "min_distance", Length, true, "tip–sample distance at the lower turning point",
-        F64(|f, q| q.observables.min_distance * f.u.length);
-    "peak_force", Force, true, "largest tip–sample force",
-        F64(|f, q| q.observables.peak_force * f.u.force);
-    "mean_force", Force, false, "mean tip–sample force",
-        F64(|f, q| q.observables.mean_force * f.u.force);
-    "law_force", Force, false, "the law's conservative force at the lower turning point",
-        F64(|f, q| q.law_force * f.u.force);
-    "indentation", Length, false, "largest indentation",
-        F64(|f, q| q.observables.indentation * f.u.length);
-    "max_multiplier", Fixed("1"), false, "largest Floquet multiplier modulus under the locked drive",
-        F64(|_, q| q.multipliers.first().map_or(f64::NAN, |m| m.norm()));
-    "stable", Fixed(""), false, "Floquet-stable under the locked drive", Bool(|_, q| q.stable);
-    "loop_residual", Fixed("1"), false, "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
-        F64(|_, q| q.loop_residual);
-    "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|_, q| q.iterations);
-};
-
-/// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
-/// per quantity of `COLUMNS`, one entry per z_c reached), `folds`, `reference` (the free
-/// lever's operating point), the cantilever's constants that [`super::reconstruct`] needs
-/// (`spring_constant`, `resonance_frequency`, `amplitude`), `units` (those of the columns it
-/// lists, and with a probe the spring constant's), `method`, `warnings`.
-pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
-    let frame = Frame::new(model, curve);
-    let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
-    // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
-    let spring_constant = r.stiffness * u.force / u.length;
-    let mut units = columns::units(&COLUMNS, &UnitNames::si_or_model(frame.u.si));
-    if u.si {
-        units.insert("spring_constant".into(), "N/m".into());
-    }
-    json!({
-        "curve": columns::arrays(&COLUMNS, &frame, &curve.points),
-        "folds": curve.folds.iter().map(|f| json!({"index": f.index, "z_c": frame.z_c(f.alpha5)})).collect::<Vec<_>>(),
-        "reference": {
-            "resonance_frequency": r.omega * hz,
-            "quality_factor": r.quality_factor,
-            "phase_deg": r.phase.to_degrees(),
-            "excitation": r.excitation,
-            "stiffness": spring_constant,
-        },
-        "mode": request.mode,
-        "amplitude": curve.amplitude * u.length,
-        "spring_constant": spring_constant,
-        "resonance_frequency": r.omega * hz,
-        "units": units,
-        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/afm-workflow.md)",
-        "warnings": warnings(request, model, &frame, curve),
-    })
-}
-
-/// The warnings of an FM curve's document: an amplitude outside the probe's typical range, ends
-/// given the wrong way round, a steady state not found.
-fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurve) -> Vec<String> {
-    let mut warnings: Vec<String> = Vec::new();
-    let unit = if model.probe.is_some() { "m" } else { "g0" };
-    if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
-        // the amplitude's typical range is the probe's ([`crate::probe::ranges`])
-        if let Some(why) = crate::probe::ranges::warning("drive", "free_amplitude", a) {
-            warnings.push(format!(
-                "amplitude = {} m is {why}",
-                crate::error::number(a)
-            ));
-        }
-    }
-    if let (Some(from), Some(to)) = (request.from, request.to) {
-        if from < to {
-            warnings.push(format!(
-                "from = {} {unit} is nearer the sample than to = {} {unit}: an FM curve is \
-                 taken approaching, so it runs from z_c = {} {unit} down to {} {unit} (give \
-                 from > to to say so)",
-                crate::error::number(from),
-                crate::error::number(to),
-                crate::error::number(to),
-                crate::error::number(from),
-            ));
-        }
-    }
-    if let Some(u) = &curve.unreached {
-        warnings.push(format!(
-            "the FM steady state was not found at z_c = {}{} and beyond ({}); the curve ends at \
-             the previous value",
-            crate::error::number(frame.z_c(u.alpha5)),
-            if model.probe.is_some() { " m" } else { " g0" },
-            u.reason
-        ));
-    }
-    warnings
-}
-
-/// The layout of an FM curve: over `z_c` (the rest distance, its coordinate) every column of
-/// `COLUMNS`, in the document's units (SI with a probe, the model's without; `deg` for the
-/// phase, `1` for the pure numbers); `stable` flags, `iterations` integers. What Python's
-/// `afmdyn.fm` returns.
-pub(crate) fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
-    let frame = Frame::new(model, curve);
-    let p = &curve.points;
-    let variables = columns::variables(
-        &COLUMNS,
-        &frame,
-        p,
-        &["z_c"],
-        &UnitNames::si_or_model(frame.u.si),
-    );
-    crate::layout::Layout::new("fm", &[("z_c", p.len())], variables)
-}
-
-/// The table of an FM curve (`fm.csv`): the names of `COLUMNS` and one row per z_c reached
-/// (`stable` as 1/0).
-pub(crate) fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
-    let frame = Frame::new(model, curve);
-    let rows = columns::rows(&COLUMNS, &frame, &curve.points);
-    (columns::names(&COLUMNS), rows)
 }

@@ -1,8 +1,8 @@
 //! `reconstruct`: the force and potential behind a frequency-modulation curve
 //! ([`crate::analysis::reconstruct`], the Sader–Jarvis inversion, or
 //! [`crate::analysis::reconstruct_exact`], its exact correction: [`FmInversion`]) — the request that the
-//! command line (`afmdyn reconstruct --fm FILE`) and Python (`afmdyn.reconstruct`) share, and
-//! its JSON document. SI throughout: distances and the amplitude in m, frequencies in Hz, the
+//! command line (`afmdyn reconstruct --fm FILE`) and Python (`afmdyn.reconstruct`) share: the
+//! curve, the cantilever's constants, their ranges and checks, and the declared cost. SI throughout: distances and the amplitude in m, frequencies in Hz, the
 //! spring constant in N/m; the force in N, the potential in J.
 //!
 //! **Ranges.** Each constant has a physical range outside which it is refused and a typical
@@ -30,15 +30,13 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::run::{Analysis, Request, Resolved};
-use crate::analysis::progress::Progress;
-use crate::analysis::reconstruct::{sader_jarvis, Method, Reconstruction, ShiftCurve};
+use super::run::{Request, Resolved};
+use crate::analysis::reconstruct::{Method, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
-use crate::analysis::reconstruct_exact::{check_exact, exact_inversion, exact_weights};
+use crate::analysis::reconstruct_exact::{check_exact, exact_weights};
 use crate::error::{number, SimError};
-use crate::report::present::reconstruct::{reconstruction, Inversion};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 /// `reconstruct`: a frequency-shift curve Δf against the distance of closest approach d (or
 /// the rest distance z_c, d = z_c − A), with the cantilever's k, f0 and A.
@@ -235,7 +233,7 @@ impl ReconstructRequest {
 }
 
 impl ReconstructRequest {
-    /// The request of an `afmdyn fm` document in SI (`super::fm::document`): the distances
+    /// The request of an `afmdyn fm` document in SI (the `fm` curve's document): the distances
     /// of closest approach `curve.min_distance` (the lower turning points, static deflection
     /// included), `curve.frequency_shift`, and the document's `spring_constant`,
     /// `resonance_frequency` and `amplitude` — each of the three replaced by the value given.
@@ -327,48 +325,8 @@ impl Request for ReconstructRequest {
     }
 }
 
-impl Analysis for ReconstructRequest {
-    type Output = Reconstruction;
-    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
-        match self.inversion {
-            FmInversion::SaderJarvis => sader_jarvis(&self.curve()?, progress),
-            FmInversion::Exact => exact_inversion(&self.curve()?, progress),
-        }
-    }
-    fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
-        Ok(document(self, r))
-    }
-    fn present(
-        &self,
-        r: &Reconstruction,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let how = match self.inversion {
-            FmInversion::SaderJarvis => Inversion::SaderJarvis,
-            FmInversion::Exact => Inversion::Exact,
-        };
-        present_reconstruction(r, how, self.law_in_order(), at.document, at.units, at.to)
-    }
-}
-
-/// A reconstruction's presentation at `to` ([`crate::report::present::reconstruct::reconstruction`]),
-/// the printed document naming its table.
-fn present_reconstruction(
-    r: &Reconstruction,
-    how: Inversion,
-    law: Option<Vec<f64>>,
-    document: &Value,
-    units: crate::report::TextUnits,
-    to: super::run::Destination<'_>,
-) -> Result<crate::report::Presentation, SimError> {
-    let mut document = document.clone();
-    let mut shown = reconstruction(r, how, law, &mut document, units, to);
-    shown.document = Some(document);
-    Ok(shown)
-}
-
 /// `reconstruct --am`: the AM matrix inversion of an `afmdyn approach --probe` document of
-/// the point mass (`am_curve_from_approach`, `am_reconstruction`).
+/// the point mass (`am_curve_from_approach`).
 #[derive(Debug, Clone)]
 pub struct AmReconstruction(pub Value);
 
@@ -388,66 +346,6 @@ impl Request for AmReconstruction {
             work: 0.0,
         })
     }
-}
-
-impl Analysis for AmReconstruction {
-    type Output = Reconstruction;
-    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
-        let curve = am_curve_from_approach(&self.0)?;
-        crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)
-    }
-    fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
-        Ok(am_document(&am_curve_from_approach(&self.0)?, r))
-    }
-    fn present(
-        &self,
-        r: &Reconstruction,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<crate::report::Presentation, SimError> {
-        present_reconstruction(r, Inversion::AmMatrix, None, at.document, at.units, at.to)
-    }
-}
-
-/// The document of a reconstruction (`afmdyn reconstruct --json`): `force` (`distance` (m),
-/// `force` (N), `potential` (J), increasing distance; `law` (N), the model's force there, for a
-/// curve from an `fm` document), the cantilever's constants, `method`,
-/// `units`, `warnings` ([`ReconstructRequest::warnings`]: constants outside their typical
-/// ranges, data that end before the shift has decayed); `inversion` (`"sader-jarvis"` or
-/// `"exact"`) and for the exact inversion `exact` ([`ExactRecord`]: `iterations`,
-/// `sader_jarvis_residual`, `forward_residual`, `converged`).
-///
-/// [`ExactRecord`]: crate::analysis::reconstruct::ExactRecord
-pub(crate) fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
-    let mut force = json!({"distance": r.distance, "force": r.force, "potential": r.potential});
-    if let Some(law) = request.law_in_order() {
-        force["law"] = json!(law);
-    }
-    let method = match request.inversion {
-        FmInversion::SaderJarvis => {
-            "Sader-Jarvis inversion (Appl. Phys. Lett. 84, 1801 (2004)); potential by \
-             integrating the force from the last distance"
-        }
-        FmInversion::Exact => {
-            "exact inversion of Giessibl's first-order relation: the Sader-Jarvis estimate \
-             corrected by defect correction through the piecewise-linear forward relation \
-             (Giessibl's matrix method, Appl. Phys. Lett. 78, 123 (2001)); potential by \
-             integrating the force from the last distance"
-        }
-    };
-    let mut doc = json!({
-        "force": force,
-        "spring_constant": request.spring_constant,
-        "resonance_frequency": request.resonance_frequency,
-        "amplitude": request.amplitude,
-        "inversion": request.inversion.word(),
-        "method": method,
-        "units": {"distance": "m", "force": "N", "potential": "J"},
-        "warnings": request.warnings(),
-    });
-    if let Some(e) = &r.exact {
-        doc["exact"] = json!(e);
-    }
-    doc
 }
 
 /// The AM curve of an `afmdyn approach --probe` document of the point-mass model (`reconstruct
@@ -538,96 +436,4 @@ pub(crate) fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
         ));
     }
     Ok(curve)
-}
-
-/// The document of an AM reconstruction (`afmdyn reconstruct --am`): as [`document`]'s, with
-/// `amplitude` the free amplitude A₀, `quality_factor`, `drive_frequency` and the points used.
-pub(crate) fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
-    json!({
-        "force": {"distance": r.distance, "force": r.force, "potential": r.potential},
-        "spring_constant": curve.spring_constant,
-        "resonance_frequency": curve.resonance_frequency,
-        "amplitude": curve.free_amplitude,
-        "quality_factor": curve.quality_factor,
-        "drive_frequency": curve.drive_frequency,
-        "points": curve.z_c.len(),
-        "method": "AM inversion: the first-harmonic balance kA(1 - w^2/w0^2) - F0 cos(phi) = \
-                   (1/pi) integral of F cos(theta), inverted by Giessibl's matrix method (Appl. \
-                   Phys. Lett. 78, 123 (2001)) with hat functions at each point's lower turning \
-                   point and amplitude (analysis::reconstruct_am); the approach's attractive run \
-                   (phase lag above 90 degrees)",
-        "units": {"distance": "m", "force": "N", "potential": "J"},
-        "warnings": [
-            "the force near the largest distance is not reconstructed: the inversion integrates \
-             the curve beyond each distance, and the data end there (start the approach where \
-             the amplitude and phase are the free ones)"
-        ],
-    })
-}
-
-/// The reconstruction of an `afmdyn approach --probe` document of the point mass and its JSON
-/// document ([`am_curve_from_approach`], [`crate::analysis::reconstruct_am::matrix_inversion`],
-/// [`am_document`]): `reconstruct --am` of every front end.
-///
-/// Counts the rows in `progress` and stops at its cancel flag.
-///
-/// # Errors
-/// As [`am_curve_from_approach`] and the inversion
-/// ([`crate::analysis::reconstruct_am::matrix_inversion`]).
-pub(crate) fn am_reconstruction(
-    approach: &Value,
-    progress: &Progress,
-) -> Result<super::run::Document<Reconstruction>, SimError> {
-    let curve = am_curve_from_approach(approach)?;
-    let r = crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)?;
-    Ok(super::run::Document {
-        json: am_document(&curve, &r),
-        output: r,
-    })
-}
-
-/// The variables of a reconstruction's layout ([`layout`]) after `distance`: name, unit (SI,
-/// as the documents' `units` name them: [`document`], [`am_document`]) and long name; `law`
-/// only for a curve that carries the model's force (an `fm` document's).
-const RECONSTRUCT_VARIABLES: [(&str, &str, &str); 3] = [
-    (
-        "law",
-        "N",
-        "the model's force at d (a curve from afmdyn.fm)",
-    ),
-    ("force", "N", "tip–sample force F(d)"),
-    (
-        "potential",
-        "J",
-        "potential U(d), integral of F from d to the last distance",
-    ),
-];
-
-/// The layout of a reconstruction `r` (what Python's `afmdyn.reconstruct` returns): over
-/// `distance` (the distance of closest approach d in m, increasing; its coordinate) `law`
-/// (N; with `law`, the model's force at each distance in that order:
-/// `ReconstructRequest::law_in_order`), `force` (N) and `potential` (J), SI as the
-/// documents.
-pub(crate) fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
-    use crate::layout::{Layout, Variable};
-    let d = ["distance"];
-    let mut variables = vec![Variable::f64(
-        "distance",
-        &d,
-        "m",
-        "distance of closest approach d",
-        &r.distance,
-    )];
-    for (name, unit, long_name) in RECONSTRUCT_VARIABLES {
-        let values = match name {
-            "law" => match &law {
-                Some(l) => l.as_slice(),
-                None => continue,
-            },
-            "force" => r.force.as_slice(),
-            _ => r.potential.as_slice(),
-        };
-        variables.push(Variable::f64(name, &d, unit, long_name, values));
-    }
-    Layout::new("reconstruct", &[("distance", r.distance.len())], variables)
 }

@@ -31,6 +31,10 @@
 //!   `peakforce` (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
 //!   sweep's points, its branches continued across them, stored in its checkpoint). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
+//! - the running of the requests that are one computation (their `Analysis`: execution,
+//!   document, presentation, layouts), beside the requests in [`crate::request`]: `fit` and
+//!   `fit_dynamic` (a force curve's and a dynamic curve's fit), `fm` (an FM curve) and
+//!   `reconstruct` (the force behind an FM or AM curve, and `reconstruct_document`'s run).
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -44,6 +48,9 @@ pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
+pub(crate) mod fit;
+pub(crate) mod fit_dynamic;
+pub(crate) mod fm;
 pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
@@ -52,6 +59,7 @@ pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
+pub(crate) mod reconstruct;
 pub mod scan;
 #[cfg(feature = "files")]
 pub(crate) mod scan_store;

@@ -86,7 +86,7 @@ fn held_line(document: &Value, text: TextUnits) -> Option<String> {
     (!held.is_empty()).then(|| format!("held: {}", held.join(", ")))
 }
 
-/// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
+/// The presentation of a fit's `document` (`study::fit::document`): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
 pub(crate) fn fit(document: &mut Value, text: TextUnits, to: Destination<'_>) -> Presentation {
     let mut p = tail();

@@ -6,8 +6,8 @@ use crate::layout::figure::{Series, Style};
 use crate::report::{Presentation, TextUnits};
 use serde_json::Value;
 
-/// The presentation of an FM curve's `document` ([`crate::request::fm::document`]) and its
-/// table (column names and rows, [`crate::request::fm::table`]): the summary (Δf at both ends,
+/// The presentation of an FM curve's `document` (`study::fm::document`) and its
+/// table (column names and rows, `study::fm::table`): the summary (Δf at both ends,
 /// the largest excitation, unstable points and folds), and with `files` the table `fm.csv`,
 /// the figure (all files) and the document `fm.json`; when the files go to `dir`, the document
 /// records the table's path there (`"csv"`, in the document printed too).
