@@ -160,6 +160,26 @@ fn run_example(csv: &str, extra: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
+/// An exact inversion that stops above round-off says so on the command line (the battery:
+/// `exact.converged = false` with no warning on 9 of 9 smooth curves, the documented example
+/// included): the warning is there exactly when the document's `exact.converged` is false.
+#[test]
+fn an_unconverged_exact_inversion_is_warned_of() {
+    let (code, out, err) = run_example(FM, &["--inversion", "exact", "--json"]);
+    assert_eq!(code, Some(0), "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let converged = doc["exact"]["converged"].as_bool().unwrap();
+    let warned = |text: &str| text.contains("the exact inversion did not converge");
+    let in_doc = doc["warnings"].as_array().unwrap().iter();
+    assert_eq!(
+        in_doc.filter(|w| warned(w.as_str().unwrap())).count(),
+        usize::from(!converged)
+    );
+    assert_eq!(warned(&err), !converged, "{err}");
+    // the documented example is such a curve: its residual sits at the data's end
+    assert!(!converged, "{}", doc["exact"]);
+}
+
 /// Constants outside their physical range are refused naming the flag and the range (1e300 m
 /// was "distance must increase"; -10nm was clap's "unexpected argument '-1'"; 10 m ran).
 #[test]

@@ -114,8 +114,30 @@ pub(crate) fn document(request: &ReconstructRequest, r: &Reconstruction) -> Valu
     });
     if let Some(e) = &r.exact {
         doc["exact"] = json!(e);
+        if let (Some(w), Some(ws)) = (exact_warning(e), doc["warnings"].as_array_mut()) {
+            ws.push(w.into());
+        }
     }
     doc
+}
+
+/// The warning of an exact inversion that did not converge to round-off
+/// (`crate::analysis::reconstruct_exact`: it stops where a correction step no longer shrinks
+/// the forward residual, typically in the rows within 2A of the data's end), or `None`.
+fn exact_warning(e: &crate::analysis::reconstruct::ExactRecord) -> Option<String> {
+    (!e.converged).then(|| {
+        format!(
+            "the exact inversion did not converge (exact.converged = false): it stopped after \
+             {} correction step(s) at a forward residual of {} of the largest |Δf| (Sader–Jarvis's: \
+             {}), above round-off ({}), where a step no longer shrank it — usually in the rows \
+             within 2A of the data's end, whose cycles reach beyond the data; the force is the \
+             last iterate",
+            e.iterations,
+            crate::error::number(e.forward_residual),
+            crate::error::number(e.sader_jarvis_residual),
+            crate::error::number(crate::analysis::reconstruct_exact::EXACT_TOLERANCE),
+        )
+    })
 }
 
 /// The document of an AM reconstruction (`afmdyn reconstruct --am`): as [`document`]'s, with
