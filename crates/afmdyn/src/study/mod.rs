@@ -40,6 +40,7 @@
 //! finishes. Dask (`afmdyn.dask`) is another executor of the same tasks: it ships them to
 //! workers and writes through the same layout.
 
+pub(crate) mod analyses;
 pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
@@ -62,6 +63,7 @@ pub mod sweep;
 #[cfg(feature = "files")]
 pub(crate) mod task_store;
 
+pub use analyses::advance_from_rest;
 pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
 
