@@ -49,6 +49,7 @@ pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
 mod memory;
+pub(crate) mod modes;
 pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
