@@ -57,6 +57,9 @@ pub mod plan;
 pub mod scan;
 #[cfg(feature = "files")]
 pub(crate) mod scan_store;
+pub(crate) mod simulate;
+#[cfg(feature = "files")]
+pub mod simulate_stream;
 pub mod stepped;
 #[cfg(feature = "files")]
 pub mod stored;
