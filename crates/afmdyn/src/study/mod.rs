@@ -45,6 +45,9 @@ pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
+pub mod checkpoint;
+#[cfg(feature = "files")]
+pub(crate) mod checkpoint_file;
 pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
@@ -54,6 +57,7 @@ pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
+pub(crate) mod pool;
 pub mod scan;
 #[cfg(feature = "files")]
 pub(crate) mod scan_store;
@@ -70,10 +74,11 @@ pub(crate) mod task_store;
 pub use analyses::advance_from_rest;
 pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
+pub(crate) use pool::in_pool;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::checkpoint::CheckpointError;
+use crate::study::checkpoint::CheckpointError;
 use serde_json::Value;
 use std::collections::{BTreeMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -307,7 +312,7 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
         drop(guard);
         observer.stored(units, count.fetch_add(1, Ordering::SeqCst) + 1);
     };
-    let ran = crate::request::in_pool(threads, || study.run(&done, &sink, cancel));
+    let ran = crate::study::in_pool(threads, || study.run(&done, &sink, cancel));
     let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
     if let Some(e) = failed {
         return Err(e.into());

@@ -427,7 +427,7 @@ impl PlanStore for SweepStore {
         Ok(self.checkpoint().finish(&self.fingerprint)?)
     }
     fn outcome(&mut self) -> Result<Outcome, StudyError> {
-        let recs = crate::request::checkpoint_file::final_rows(self.lock.path())?;
+        let recs = crate::study::checkpoint_file::final_rows(self.lock.path())?;
         if let Some(e) = every_point_failed(&recs) {
             return Err(e.into());
         }

@@ -8,12 +8,12 @@ use super::{Resumes, Study};
 use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::checkpoint::{end_state, point_count};
 use crate::request::costs::{state_bytes, steady_periods, MODEL_BYTES};
 use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Request, Resolved};
 use crate::request::sweep::{records, SweepRecord};
 use crate::request::BifurcationRequest;
+use crate::study::checkpoint::{end_state, point_count};
 use serde_json::Value;
 use std::sync::atomic::AtomicBool;
 
@@ -98,7 +98,7 @@ impl Request for BifurcationRequest {
         let spec = self.spec(&model.params)?;
         let p = &spec.base;
         let values = spec.values.len() as f64;
-        let points = crate::request::checkpoint::point_count(&spec) as f64;
+        let points = crate::study::checkpoint::point_count(&spec) as f64;
         let coarse = if spec.continuation { 2.0 * values } else { 0.0 };
         let recorded = spec.steady.max_period.max(spec.steady.nonperiodic_record) as f64;
         // the transient cap at the range's ends (a model's decay, and with it the cap, moves
@@ -159,7 +159,7 @@ impl Resumes<Vec<SweepRecord>> for Resume {
 
 /// The codec of a sweep's checkpoint (the directory's `.bifurcation.run.json` and
 /// `.bifurcation.partial.csv`, its rows put in the one order in `bifurcation.csv` when the
-/// sweep finishes: `crate::request::checkpoint_file`), a point's rows stored together.
+/// sweep finishes: `crate::study::checkpoint_file`), a point's rows stored together.
 #[cfg(feature = "files")]
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SweepRows;
@@ -169,7 +169,7 @@ impl super::task_store::Codec for SweepRows {
     type Record = Vec<SweepRecord>;
 
     fn layout(&self) -> super::task_store::Layout {
-        use crate::request::checkpoint_file::{FINAL_CSV, LEDGER, PARTIAL_CSV};
+        use crate::study::checkpoint_file::{FINAL_CSV, LEDGER, PARTIAL_CSV};
         super::task_store::Layout {
             ledger: LEDGER,
             records: PARTIAL_CSV,
@@ -181,11 +181,11 @@ impl super::task_store::Codec for SweepRows {
     }
 
     fn header(&self) -> Option<String> {
-        Some(crate::request::checkpoint_file::partial_header())
+        Some(crate::study::checkpoint_file::partial_header())
     }
 
     fn encode(&self, point: &Vec<SweepRecord>) -> Result<String, String> {
-        let seal = |r: &SweepRecord| crate::request::checkpoint_file::sealed(&r.csv_line()) + "\n";
+        let seal = |r: &SweepRecord| crate::study::checkpoint_file::sealed(&r.csv_line()) + "\n";
         Ok(point.iter().map(seal).collect())
     }
 
@@ -193,15 +193,15 @@ impl super::task_store::Codec for SweepRows {
         &self,
         path: &std::path::Path,
         each: &mut dyn FnMut(Vec<SweepRecord>),
-    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
-        crate::request::checkpoint_file::read_points(path, each)
+    ) -> Result<(), crate::study::checkpoint::CheckpointError> {
+        crate::study::checkpoint_file::read_points(path, each)
     }
 
     fn finish(
         &self,
         dir: &std::path::Path,
-    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
-        crate::request::checkpoint_file::sort_into_final(dir)
+    ) -> Result<(), crate::study::checkpoint::CheckpointError> {
+        crate::study::checkpoint_file::sort_into_final(dir)
     }
 }
 
