@@ -7,7 +7,10 @@
 //! Model values are not part of these requests: they resolve first, through
 //! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
 
+use super::costs::{census_cost, state_bytes, steady_periods, MODEL_BYTES};
 use super::limits::*;
+use super::run::{Request, Resolved};
+use super::sweep::SweepRecord;
 use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::global_continuation::{
@@ -551,6 +554,53 @@ impl BifurcationRequest {
         };
         spec.validate()?;
         Ok(spec)
+    }
+}
+
+impl Request for BifurcationRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "bifurcation"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every point (each value reached forward, backward and from each random start) and
+        // each continued branch's coarse pass over its chunks (at most one point a value):
+        // the steady-state search to its transient cap, then the recorded periods (one cycle
+        // of up to max_period, or nonperiodic_record), whose Poincaré points are the records
+        let spec = self.spec(&model.params)?;
+        let p = &spec.base;
+        let values = spec.values.len() as f64;
+        let points = super::sweep::point_count(&spec) as f64;
+        let coarse = if spec.continuation { 2.0 * values } else { 0.0 };
+        let recorded = spec.steady.max_period.max(spec.steady.nonperiodic_record) as f64;
+        // the transient cap at the range's ends (a model's decay, and with it the cap, moves
+        // monotonically with one parameter)
+        let (lo, hi) = (spec.values.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |b, &v| {
+            (b.0.min(v), b.1.max(v))
+        });
+        let cap = steady_periods(&spec.steady, &p.with(spec.param, lo))?
+            .max(steady_periods(&spec.steady, &p.with(spec.param, hi))?);
+        let record = std::mem::size_of::<SweepRecord>() as f64 + state_bytes(p) + 64.0;
+        Ok(Cost {
+            bytes: MODEL_BYTES + points * recorded * record,
+            work: (points + coarse) * (cap + recorded) * p.modes as f64,
+        })
+    }
+}
+
+impl Request for GlobalContinuationRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "attractors --sweep"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // one census per value
+        let spec = self.spec(&model.params)?;
+        census_cost(&spec.census, spec.values.len())
     }
 }
 

@@ -24,7 +24,7 @@ use super::analyses::{
     AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
     OrbitRequest,
 };
-use super::costs::{census_cost, converge_cost};
+use super::costs::{census_cost, converge_cost, stepped_cost};
 use super::costs::{check_cost, newton_work, start_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
@@ -501,3 +501,49 @@ impl ResonanceRequest {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(transparent)]
 pub struct Bimodal(pub ApproachRequest);
+
+impl Request for ApproachRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "approach"
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
+    }
+}
+
+impl Request for ResonanceRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "resonance"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
+    }
+}
+
+impl Request for Bimodal {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        self.0.validate(model)
+    }
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        self.0.cost(model)
+    }
+}

@@ -2,10 +2,9 @@
 //! the `files` feature a directory): its errors ([`CheckpointError`]), its ledger ([`Ledger`]:
 //! the fingerprint of the request that made it — a resume of another request is refused,
 //! naming the first field that differs — and whether it finished), and of a bifurcation
-//! sweep's checkpoint the number of its points and the state a stored point's chain goes on
+//! sweep's checkpoint the state a stored point's chain goes on
 //! from.
 
-use crate::analysis::bifurcation::SweepSpec;
 use crate::request::sweep::{first_difference, SweepRecord};
 use nalgebra::DVector;
 use serde_json::Value;
@@ -82,11 +81,6 @@ pub(crate) fn same_request(
         }),
         None => Ok(()),
     }
-}
-
-/// The number of points of a sweep: values × (2 with continuation + random starts).
-pub fn point_count(spec: &SweepSpec) -> usize {
-    spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize)
 }
 
 /// The continuation state of a stored point: the state of its last record, unless it failed.

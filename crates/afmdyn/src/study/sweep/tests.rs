@@ -6,6 +6,7 @@ use crate::analysis::bifurcation::Branch;
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::params::Params;
+use crate::request::sweep::point_count;
 use crate::request::sweep::SweepRecord;
 use crate::request::sweep::{order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
