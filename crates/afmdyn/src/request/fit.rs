@@ -750,10 +750,14 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
     doc
 }
 
-impl super::named::Datasets for FitRequest {
+impl crate::study::named::Datasets for FitRequest {
     /// `curve` (tip position, force, fit and residual over the fitted rows); the estimates
     /// and their standard errors as facts.
-    fn datasets(&self, _: &Resolved, r: &FitResult) -> Result<super::named::Arrays, SimError> {
+    fn datasets(
+        &self,
+        _: &Resolved,
+        r: &FitResult,
+    ) -> Result<crate::study::named::Arrays, SimError> {
         use crate::layout::{Layout, Variable};
         let doc = document(self, r);
         let arr = |k: &str| -> Vec<f64> {

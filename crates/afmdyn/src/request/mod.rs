@@ -14,8 +14,8 @@
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
-//! - [`named`]: every analysis by its name ([`named::parse`]), run to an [`Outcome`]: its
-//!   document and its arrays as layouts ([`Datasets`]); the one door of Python and WebAssembly.
+//! - [`named`]: every analysis by its name ([`named::parse`]) as a [`named::NamedRequest`];
+//!   the one door of Python and WebAssembly.
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason, and the budgets of
 //!   a request's cost ([`limits::Cost`]), which `costs` estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
@@ -32,7 +32,6 @@ pub mod basins;
 pub mod chart;
 pub(crate) mod costs;
 pub mod curves;
-mod datasets;
 #[cfg(feature = "files")]
 pub(crate) use crate::io::dir_lock;
 pub mod fm;
@@ -77,7 +76,6 @@ pub use fit::FitRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};
-pub use named::{Datasets, Named, Outcome};
 pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
 pub use reconstruct::ReconstructRequest;
 pub use run::{

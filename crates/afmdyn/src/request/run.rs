@@ -224,7 +224,7 @@ pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(),
 ///
 /// # Errors
 /// As [`admit`], less the budget's.
-pub(crate) fn validate<A: Analysis + ?Sized>(
+pub(crate) fn validate<A: Request + ?Sized>(
     analysis: &A,
     model: &Resolved,
 ) -> Result<(), SimError> {

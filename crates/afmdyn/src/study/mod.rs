@@ -48,11 +48,13 @@ pub mod chart_store;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub(crate) mod checkpoint_file;
+mod datasets;
 pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
 mod memory;
 pub(crate) mod modes;
+pub mod named;
 pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]

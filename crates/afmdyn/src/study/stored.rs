@@ -5,12 +5,13 @@
 //! by name ([`parse`]: `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`,
 //! `resonance`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
 //! ([`Prepared::run`]) to the outcome the one door gives for the same request
-//! (`crate::request::named::outcome`).
+//! (`super::named::outcome`).
 
 use super::basins::{basin_store, BasinStudy};
 use super::chart::cells_of;
 use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
+use super::named::{self, Datasets, Outcome};
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
 use super::sweep::{sweep_checkpoint, SweepStudy};
@@ -24,7 +25,6 @@ use crate::report::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, S
 use crate::request::chart::Chart;
 use crate::request::image_job::{ImageJob, ImageOutput};
 use crate::request::image_scan::ScanStudy;
-use crate::request::named::{self, Datasets, Outcome};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
 use crate::request::GlobalContinuationRequest;

@@ -1,22 +1,22 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
 //! The stepped curves' layouts are laid out from their documents; `fm`'s is
-//! [`super::fm::layout`], `reconstruct`'s [`super::reconstruct::layout`].
+//! [`crate::request::fm::layout`], `reconstruct`'s [`crate::request::reconstruct::layout`].
 
-use super::modes::ModesRequest;
 use super::named::Datasets;
-use super::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
-use super::BasinArrays;
-use super::{
-    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,
-    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, ReconstructRequest,
-};
 use crate::analysis::steady::SteadyState;
 use crate::eigen::RegionSpectrum;
 use crate::error::SimError;
 use crate::layout::{Layout, Values, Variable};
 use crate::model::CantileverModel;
 use crate::report;
+use crate::request::modes::ModesRequest;
+use crate::request::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
+use crate::request::BasinArrays;
+use crate::request::{
+    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,
+    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, ReconstructRequest,
+};
 use nalgebra::DVector;
 use serde_json::{json, Map, Value};
 
@@ -133,7 +133,7 @@ impl Datasets for ObserveRequest {
     /// The observables' layout from the document (`crate::report::curve_layout::observe_layout`)
     /// and the period.
     fn datasets(&self, model: &Resolved, o: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, o)?;
+        let doc = crate::request::run::document(self, model, o)?;
         let layout =
             crate::report::curve_layout::observe_layout(&doc, o.state.as_slice(), o.period);
         Ok((
@@ -321,7 +321,7 @@ impl Datasets for GlobalContinuationRequest {
 impl Datasets for ApproachRequest {
     /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, curve)?;
+        let doc = crate::request::run::document(self, model, curve)?;
         one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }
@@ -329,23 +329,23 @@ impl Datasets for ApproachRequest {
 impl Datasets for ResonanceRequest {
     /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, curve)?;
+        let doc = crate::request::run::document(self, model, curve)?;
         one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }
 
 impl Datasets for FmRequest {
-    /// The curve's layout `fm` (`super::fm::layout`).
+    /// The curve's layout `fm` (`crate::request::fm::layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        one("fm", super::fm::layout(model, curve))
+        one("fm", crate::request::fm::layout(model, curve))
     }
 }
 
 impl Datasets for ReconstructRequest {
-    /// The reconstruction's layout `reconstruct` (`super::reconstruct::layout`, with the
+    /// The reconstruction's layout `reconstruct` (`crate::request::reconstruct::layout`, with the
     /// request's `law_force`).
     fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
-        let layout = super::reconstruct::layout(r, self.law_in_order());
+        let layout = crate::request::reconstruct::layout(r, self.law_in_order());
         one("reconstruct", layout)
     }
 }
