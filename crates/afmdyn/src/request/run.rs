@@ -5,15 +5,15 @@
 //! Every analysis whose result is one value implements [`Analysis`]: `modes`, `orbit`,
 //! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`,
 //! and the studies that run in memory here and resumably in a front end's store — `basins`,
-//! `attractors --sweep`, `approach` and `resonance` (their `Analysis` is beside the study, in
-//! `crate::study::basins`, `crate::study::global_continuation` and `crate::study::stepped`).
-//! The two whose results are streams enter through it too: `simulate` streamed to files
+//! `attractors --sweep`, `approach` and `resonance`. What a request is ([`Request`]: its
+//! checks and declared cost) is here, beside the requests; how it runs (every `Analysis`
+//! implementation) is the study layer's (`crate::study`). The two whose results are streams
+//! enter through it too: `simulate` streamed to files
 //! ([`crate::request::simulate_stream::SimulateStream`]: recorded in chunks by
 //! `crate::trajectory::chunked::record_chunked`, its series' bytes held against the files'
 //! budget, [`crate::request::analyses::SimulateSpan`]), and `bifurcation`, whose `execute` is
 //! the in-memory sweep; a front end that runs the sweep resumably into a store of its own
-//! ([`crate::study::sweep::SweepStudy`] into its checkpoint) checks its cost
-//! first by [`admit`].
+//! (the sweep's study into its checkpoint) checks its cost first by [`admit`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
 //! their units of work in it (random starts, curve and branch points, drive periods, mode
