@@ -19,9 +19,9 @@ use crate::analysis::global_continuation::{
 use crate::analysis::lyapunov::LyapunovOptions;
 use crate::analysis::observables::Observables;
 use crate::analysis::period::MAX_PERIOD;
-use crate::analysis::steady::{steady_state, SteadyOptions};
+use crate::analysis::steady::SteadyOptions;
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;

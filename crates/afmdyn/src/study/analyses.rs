@@ -12,7 +12,7 @@ use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovSpectrum};
 use crate::analysis::observables::{observe_from, ObservableOptions};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
-use crate::analysis::steady::{default_transient_cap, SteadyOptions};
+use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::maps::StroboscopicMap;
@@ -21,11 +21,51 @@ use crate::params::Params;
 use crate::report::{self, CurveUnits};
 use crate::request::analyses::{
     initial_state, AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest,
-    ObserveRequest, ObserveResult, OrbitRequest,
+    ObserveRequest, ObserveResult, OrbitRequest, StartRequest,
 };
 use crate::request::limits::CASCADE_FACTOR;
 use crate::request::run::{Analysis, Presenting, Resolved};
+use nalgebra::DVector;
 use serde_json::Value;
+
+/// [`StartRequest::guess_with_section`]: the guess, the period found, the recorded section
+/// points (each of shape `[2N]`).
+pub(crate) type GuessWithSection = (DVector<f64>, Option<usize>, Vec<DVector<f64>>);
+
+impl StartRequest {
+    /// The guess and, when a steady state was searched, its period.
+    ///
+    /// # Errors
+    /// As [`initial_state`], [`crate::request::analyses::SteadyRequest::options`] and [`steady_state`].
+    pub(crate) fn guess(
+        &self,
+        model: &CantileverModel,
+    ) -> Result<(DVector<f64>, Option<usize>), SimError> {
+        let (z, found, _) = self.guess_with_section(model)?;
+        Ok((z, found))
+    }
+
+    /// [`Self::guess`] with the section points the steady-state search recorded (z(kT) of
+    /// consecutive drive periods, the last one the guess; empty for a given `initial`): the
+    /// starts of [`crate::analysis::shooting::Guess::Section`] when Newton from the guess fails.
+    ///
+    /// # Errors
+    /// As [`Self::guess`].
+    pub(crate) fn guess_with_section(
+        &self,
+        model: &CantileverModel,
+    ) -> Result<GuessWithSection, SimError> {
+        let steady = self.steady.options()?;
+        let z0 = initial_state(model, self.initial.as_deref())?;
+        if self.initial.is_some() {
+            return Ok((z0, None, Vec::new()));
+        }
+        let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
+        let s = steady_state(integ.as_mut(), &steady)?;
+        let section = s.poincare.iter().map(|p| p.state.clone()).collect();
+        Ok((s.end_state().clone(), s.period(), section))
+    }
+}
 
 impl OrbitRequest {
     /// The orbit of `params`: Newton shooting ([`shoot`]) from the guess; when that fails to
