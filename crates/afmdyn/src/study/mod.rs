@@ -32,6 +32,12 @@
 //!   sweep's points, its branches continued across them, stored in its checkpoint). A chain's resume reads its stored records back (its next task starts from
 //!   them: `Done` is the records); a study of independent tasks reads only their numbers.
 //!
+//! - the running of the requests (`crate::request` holds what they are): the one-value
+//!   analyses' `Analysis` (`analyses`, `modes`), `simulate` recorded whole (`simulate`) or
+//!   streamed to files (`simulate_stream`), a request run by its name to its outcome
+//!   ([`named`], its arrays `datasets`), and what the stores share ([`checkpoint`], with the
+//!   sweep's checkpoint file `checkpoint_file`) and the worker pool (`pool`).
+//!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
 //!
