@@ -1,6 +1,6 @@
 //! CLI errors: bad input (exit code 2) or failures while running (exit code 1).
 
-use afmdyn::request::checkpoint::CheckpointError;
+use afmdyn::study::checkpoint::CheckpointError;
 use thiserror::Error;
 
 /// What can go wrong in a command.

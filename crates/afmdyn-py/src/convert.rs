@@ -167,7 +167,7 @@ pub fn request<R: serde::de::DeserializeOwned>(
 pub fn named(
     name: &str,
     kwargs: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Box<dyn afmdyn::request::Named>> {
+) -> PyResult<afmdyn::request::named::NamedRequest> {
     // the curve of a multifrequency drive is the approach curve's request
     let what = if name == "bimodal" { "approach" } else { name };
     deserialize(what, kwargs, |d| afmdyn::request::named::parse(name, d))?

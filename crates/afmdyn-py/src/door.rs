@@ -15,7 +15,8 @@ use afmdyn::error::SimError;
 use afmdyn::probe::{Probe, ProbeNeeds};
 use afmdyn::request::Params;
 use afmdyn::request::Progress;
-use afmdyn::request::{Outcome, Resolved};
+use afmdyn::request::Resolved;
+use afmdyn::study::named::Outcome;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

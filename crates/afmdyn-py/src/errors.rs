@@ -2,8 +2,8 @@
 //! line's exit code 2), a failed computation an `afmdyn.SimulationError` (a `RuntimeError`).
 
 use afmdyn::error::{ParamError, SimError};
-use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{DirLock, LockError};
+use afmdyn::study::checkpoint::CheckpointError;
 use afmdyn::study::StudyError;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;

@@ -89,7 +89,7 @@ impl BifurcationSession {
         let (model, request) = crate::resolve(input, "bifurcation")?;
         let request: BifurcationRequest = crate::request(request)?;
         let spec = request.spec(&model.params).map_err(|e| e.to_string())?;
-        let total = afmdyn::request::checkpoint::point_count(&spec);
+        let total = afmdyn::request::sweep::point_count(&spec);
         Ok(BifurcationSession {
             study: SweepStudy::new(&request, spec),
             store: MemoryStore::default(),

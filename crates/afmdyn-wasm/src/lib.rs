@@ -175,7 +175,7 @@ pub fn reconstruct_fm(fm: &str) -> Result<String, JsError> {
 }
 
 /// The model of `input` (its `model` and `probe`; no `request`) integrated from rest over
-/// `periods` drive periods ([`afmdyn::request::analyses::advance_from_rest`]): the final state
+/// `periods` drive periods ([`afmdyn::study::advance_from_rest`]): the final state
 /// `z` (shape `[2N]`, (a, ȧ)) as JSON, the engine's cost per forcing period timed by the
 /// caller.
 ///
@@ -183,8 +183,7 @@ pub fn reconstruct_fm(fm: &str) -> Result<String, JsError> {
 /// `periods` outside 1..=1000000; as [`run_json`]'s model; the integrator's.
 pub fn advance_periods(input: &str, periods: usize) -> Result<String, String> {
     let (model, _) = resolve(input, "periods")?;
-    let z = afmdyn::request::analyses::advance_from_rest(&model.params, periods)
-        .map_err(|e| e.to_string())?;
+    let z = afmdyn::study::advance_from_rest(&model.params, periods).map_err(|e| e.to_string())?;
     Ok(serde_json::to_string(&z).expect("numbers serialise"))
 }
 

@@ -67,7 +67,7 @@
 //!   one after another; every seed comes from the run's index, so the results are the same.
 //! * `files` — the library's I/O: reading probe files (`Probe::load(path)`; [`probe::Probe::parse`]
 //!   takes the TOML text and is always there), the studies' stores in locked directories
-//!   (`request::checkpoint_file`, `study::chart_store`, `io::dir_lock`), the sample maps'
+//!   (`study::checkpoint_file`, `study::chart_store`, `io::dir_lock`), the sample maps'
 //!   height map files (`io::height_map`: CSV and NPY) and the result files: NetCDF
 //!   (`layout::netcdf`), streamed CSV and NPY (`layout::files`).
 //! * `schema` — JSON Schemas of the requests (`schemars::JsonSchema` on [`request`]'s types;

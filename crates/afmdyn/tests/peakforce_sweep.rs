@@ -6,8 +6,8 @@
 use afmdyn::analysis::peakforce::{steady_tap, PeakForceOptions};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::params::{Excitation, Structure, SweepParam};
-use afmdyn::request::named::Datasets;
 use afmdyn::request::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam, Resolved};
+use afmdyn::study::named::Datasets;
 use afmdyn::{CantileverModel, ContactLaw, Params};
 
 /// The point mass with a modulated sample (α2 = 1: g₀ = A_m), f₀/f_m = `ratio`, Q = 100,

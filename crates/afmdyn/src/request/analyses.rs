@@ -1,31 +1,27 @@
 //! One request per analysis: its options with their defaults (those of `afmdyn <command>
-//! --help` and of the Python functions), `validate()` holding every limit ([`super::limits`]),
-//! and, where the analysis is one library call, `run(params)`. Errors name the library's
+//! --help` and of the Python functions), `validate()` holding every limit ([`super::limits`]);
+//! where the analysis is one library call, its `run(params)` is the study layer's. Errors name the library's
 //! parameters (`samples_per_period`, `max_period`); a front end spells them its own way
 //! ([`SimError::spelled`]).
 //!
 //! Model values are not part of these requests: they resolve first, through
 //! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
 
+use super::costs::{census_cost, state_bytes, steady_periods, MODEL_BYTES};
 use super::limits::*;
-use crate::analysis::attractors::{find_attractors, AttractorReport, AttractorSpec};
+use super::run::{Request, Resolved};
+use super::sweep::SweepRecord;
+use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::bifurcation::SweepSpec;
-use crate::analysis::continuation::{
-    continue_branch, continue_with_switching, Branch, ContinuationSpec,
-};
-use crate::analysis::converge::{mode_convergence, ConvergenceRun};
 use crate::analysis::global_continuation::{
     GlobalContinuationSpec, DEFAULT_MATCH_TOL, MAX_CONTINUATION_VALUES,
 };
-use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, LyapunovSpectrum};
-use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
+use crate::analysis::lyapunov::LyapunovOptions;
+use crate::analysis::observables::Observables;
 use crate::analysis::period::MAX_PERIOD;
-use crate::analysis::progress::Progress;
-use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
-use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
+use crate::analysis::steady::SteadyOptions;
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorKind, IntegratorOptions};
-use crate::maps::StroboscopicMap;
+use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
@@ -63,72 +59,6 @@ impl OrbitRequest {
     pub fn validate(&self) -> Result<(), SimError> {
         check_period(self.period)?;
         self.start.steady.options().map(|_| ())
-    }
-
-    /// The orbit of `params`: Newton shooting ([`shoot`]) from the guess; when that fails to
-    /// converge, the globalised Newton ([`ShootingStrategy::Globalised`]: a line search on
-    /// ½‖F‖²) from the guess, then from the closest returns among the section points the
-    /// steady-state search recorded ([`Guess::Section`]) — so that a chaotic attractor yields
-    /// an unstable periodic orbit embedded in it.
-    ///
-    /// # Errors
-    /// As [`Self::validate`], `StartRequest::guess` and [`shoot`]; the
-    /// [`SimError::NoConvergence`] of the last search tried when none converges, or
-    /// [`SimError::NoPeriod`] when the period was not given and the steady-state search from
-    /// the start found none.
-    pub fn run(&self, params: &Params) -> Result<PeriodicOrbit, SimError> {
-        self.validate()?;
-        let model = CantileverModel::new(params)?;
-        let (guess, found, section) = self.start.guess_with_section(&model)?;
-        let n = self.period.or(found).unwrap_or(1);
-        let opts = ShootingOptions::default().with_period(n);
-        let integ = || build(&model, IntegratorOptions::default(), 0.0, &model.rest());
-        let first = integ()
-            .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &guess, &opts));
-        let r = match first {
-            Err(SimError::NoConvergence { .. }) => {
-                let mut integ = integ()?;
-                let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
-                let globalised = ShootingOptions {
-                    strategy: ShootingStrategy::Globalised,
-                    ..opts
-                };
-                match shoot(map, &guess, &globalised) {
-                    Err(SimError::NoConvergence { .. }) if section.len() > n => {
-                        shoot(map, Guess::Section(&section), &globalised)
-                    }
-                    r => r,
-                }
-            }
-            r => r,
-        };
-        explain_start(r, self.period, found, self.start.searched(&model)?)
-    }
-}
-
-/// `r` with a Newton failure explained when the period was guessed: the user gave none and
-/// the steady-state search from the start (`searched`: its `max_period` and transient cap,
-/// `None` for a given initial state, which is not searched) showed none, so Newton started
-/// from the last state of a motion not periodic within `max_period`: [`SimError::NoPeriod`]
-/// (issue 28: every early end says why; issue 60 item 10: the grazing JKR orbit). The one
-/// place orbit searches and continuations say so.
-fn explain_start<T>(
-    r: Result<T, SimError>,
-    period: Option<usize>,
-    found: Option<usize>,
-    searched: Option<(usize, usize)>,
-) -> Result<T, SimError> {
-    match (r, searched) {
-        (Err(SimError::NoConvergence { residual, .. }), Some((max_period, periods)))
-            if period.is_none() && found.is_none() =>
-        {
-            Err(SimError::NoPeriod {
-                max_period,
-                periods,
-                residual,
-            })
-        }
-        (r, _) => r,
     }
 }
 
@@ -178,26 +108,6 @@ impl ContinuationRequest {
         base.with(self.param, self.to).validate()?;
         check_period(self.period)?;
         self.start.steady.options().map(|_| ())
-    }
-
-    /// The branches: one without `switch`, the cascade with it.
-    ///
-    /// # Errors
-    /// As [`Self::validate`], `StartRequest::guess`, [`crate::analysis::continuation::continue_branch`] and
-    /// [`crate::analysis::continuation::continue_with_switching`].
-    /// Every branch point is counted in `progress`, which also cancels the run.
-    pub fn run(&self, base: &Params, progress: &Progress) -> Result<Vec<Branch>, SimError> {
-        self.validate(base)?;
-        let model = CantileverModel::new(&base.with(self.param, self.from))?;
-        let (guess, found) = self.start.guess(&model)?;
-        let n = self.period.or(found).unwrap_or(1);
-        let spec = ContinuationSpec::new(*base, self.param, self.from, self.to, n);
-        let r = if self.switch {
-            continue_with_switching(&spec, &guess, CASCADE_FACTOR * n, progress)
-        } else {
-            continue_branch(&spec, &guess, progress).map(|b| vec![b])
-        };
-        explain_start(r, self.period, found, self.start.searched(&model)?)
     }
 }
 
@@ -252,27 +162,13 @@ impl LyapunovRequest {
     }
 
     /// The options, the transient `derived` where none is given.
-    fn options(&self, derived: usize) -> LyapunovOptions {
+    pub(crate) fn options(&self, derived: usize) -> LyapunovOptions {
         LyapunovOptions {
             transient_periods: self.transient.unwrap_or(derived),
             periods: self.periods,
             blocks: self.blocks,
             ..LyapunovOptions::default()
         }
-    }
-
-    /// The spectrum of `params` from the initial state, the drive periods counted in
-    /// `progress`, which also cancels the run.
-    ///
-    /// # Errors
-    /// As [`Self::validate`], [`initial_state`] and `lyapunov_spectrum_with`.
-    pub fn run(&self, params: &Params, progress: &Progress) -> Result<LyapunovSpectrum, SimError> {
-        self.validate()?;
-        let model = CantileverModel::new(params)?;
-        let z0 = initial_state(&model, self.initial.as_deref())?;
-        let opts = self.options(default_transient_cap(&model, SteadyOptions::default().tol));
-        let mut integ = build(&model, opts.integrator.clone(), 0.0, &z0)?;
-        lyapunov_spectrum_with(integ.as_mut(), &opts, progress)
     }
 }
 
@@ -328,26 +224,6 @@ impl AttractorsRequest {
         };
         spec.validate()?;
         Ok(spec)
-    }
-
-    /// The census of `params`, the random starts counted in `progress`, which also cancels
-    /// the run. Starts that fail are listed in [`AttractorReport::failures`].
-    ///
-    /// # Errors
-    /// As [`Self::spec`] and [`find_attractors`]; [`SimError::EveryRunFailed`] when every
-    /// start failed (there is no attractor to report).
-    pub fn run(&self, params: &Params, progress: &Progress) -> Result<AttractorReport, SimError> {
-        let report = find_attractors(&self.spec(params)?, progress)?;
-        if report.attractors.is_empty() {
-            if let Some(first) = report.failures.first() {
-                return Err(SimError::EveryRunFailed {
-                    what: "random starts",
-                    runs: report.failures.len(),
-                    first: first.clone(),
-                });
-            }
-        }
-        Ok(report)
     }
 }
 
@@ -503,46 +379,6 @@ impl ObserveRequest {
         }
         self.start.steady.options().map(|_| ())
     }
-
-    /// The observables of `params`: the steady state from the start, polished by Newton
-    /// shooting to 1e-12 when periodic (a transient that has not settled is tried as period 1;
-    /// when Newton fails the steady state's end point is used as it is), integrated over
-    /// `periods` of its periods.
-    ///
-    /// # Errors
-    /// As [`Self::validate`], `StartRequest::guess` and `observe_from`.
-    pub fn run(&self, params: &Params) -> Result<ObserveResult, SimError> {
-        self.validate()?;
-        let model = CantileverModel::new(params)?;
-        let (z, found) = self.start.guess(&model)?;
-        let n = found.unwrap_or(1);
-        let newton = ShootingOptions {
-            tol: 1e-12,
-            ..ShootingOptions::default()
-        }
-        .with_period(n);
-        let orbit = build(&model, IntegratorOptions::default(), 0.0, &model.rest())
-            .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &z, &newton));
-        let (state, period) = match orbit {
-            Ok(o) => (o.state, Some(n)),
-            Err(_) => (z, found),
-        };
-        let observables = observe_from(
-            &model,
-            IntegratorOptions::default(),
-            0.0,
-            &state,
-            &ObservableOptions {
-                periods: self.periods * n,
-                harmonics: self.harmonics,
-            },
-        )?;
-        Ok(ObserveResult {
-            observables,
-            state,
-            period,
-        })
-    }
 }
 
 /// `converge`: the steady tip motion for N = 1..=`max_modes` (paper Fig. 4).
@@ -618,28 +454,6 @@ impl ConvergeRequest {
             ));
         }
         Ok(())
-    }
-
-    /// The runs N = 1..=max_modes of `params` (its own N is replaced).
-    ///
-    /// # Errors
-    /// As [`Self::validate`] and `crate::analysis::converge::mode_convergence`.
-    /// Each run is counted in `progress`, which also cancels the whole.
-    pub fn run(
-        &self,
-        params: &Params,
-        progress: &Progress,
-    ) -> Result<Vec<ConvergenceRun>, SimError> {
-        self.validate()?;
-        mode_convergence(
-            params,
-            self.max_modes,
-            self.periods,
-            self.samples_per_period,
-            &SteadyOptions::default(),
-            self.integrator.options(self.samples_per_period)?,
-            progress,
-        )
     }
 }
 
@@ -743,31 +557,54 @@ impl BifurcationRequest {
     }
 }
 
+impl Request for BifurcationRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "bifurcation"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every point (each value reached forward, backward and from each random start) and
+        // each continued branch's coarse pass over its chunks (at most one point a value):
+        // the steady-state search to its transient cap, then the recorded periods (one cycle
+        // of up to max_period, or nonperiodic_record), whose Poincaré points are the records
+        let spec = self.spec(&model.params)?;
+        let p = &spec.base;
+        let values = spec.values.len() as f64;
+        let points = super::sweep::point_count(&spec) as f64;
+        let coarse = if spec.continuation { 2.0 * values } else { 0.0 };
+        let recorded = spec.steady.max_period.max(spec.steady.nonperiodic_record) as f64;
+        // the transient cap at the range's ends (a model's decay, and with it the cap, moves
+        // monotonically with one parameter)
+        let (lo, hi) = (spec.values.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |b, &v| {
+            (b.0.min(v), b.1.max(v))
+        });
+        let cap = steady_periods(&spec.steady, &p.with(spec.param, lo))?
+            .max(steady_periods(&spec.steady, &p.with(spec.param, hi))?);
+        let record = std::mem::size_of::<SweepRecord>() as f64 + state_bytes(p) + 64.0;
+        Ok(Cost {
+            bytes: MODEL_BYTES + points * recorded * record,
+            work: (points + coarse) * (cap + recorded) * p.modes as f64,
+        })
+    }
+}
+
+impl Request for GlobalContinuationRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "attractors --sweep"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // one census per value
+        let spec = self.spec(&model.params)?;
+        census_cost(&spec.census, spec.values.len())
+    }
+}
+
 pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 
 #[cfg(test)]
 mod tests;
-
-/// Most drive periods [`advance_from_rest`] integrates.
-pub(crate) const MAX_ADVANCE_PERIODS: usize = 1_000_000;
-
-/// The state `z` (shape `[2N]`, (a, ȧ)) after `periods` drive periods from rest, with the
-/// default (`auto`) integrator: the engine's cost per forcing period, which a front end times
-/// (the browser against the native build, `scripts/perf-wasm.sh`).
-///
-/// # Errors
-/// [`SimError::OutOfRange`] for `periods` outside 1..=`MAX_ADVANCE_PERIODS`; the model's
-/// and the integrator's errors.
-pub fn advance_from_rest(params: &Params, periods: usize) -> Result<Vec<f64>, SimError> {
-    if !(1..=MAX_ADVANCE_PERIODS).contains(&periods) {
-        return Err(SimError::out_of_range(
-            "periods",
-            periods,
-            "must be in 1..=1000000",
-        ));
-    }
-    let m = CantileverModel::new(params)?;
-    let mut integ = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
-    crate::integrate::advance(integ.as_mut(), periods as f64 * m.period())?;
-    Ok(integ.state().as_slice().to_vec())
-}

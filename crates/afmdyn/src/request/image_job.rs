@@ -10,9 +10,9 @@ use super::image_peakforce::PeakForceImage;
 use super::image_scan::{PiImage, PiScan};
 #[cfg(feature = "files")]
 use super::image_scan::{ScanRecipe, ScanStudy};
-use super::named::Outcome;
 use super::run::Resolved;
 use crate::error::SimError;
+use crate::study::named::Outcome;
 use serde::{Deserialize, Serialize};
 
 pub use super::image_options::ImageMode;

@@ -14,15 +14,12 @@
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
-//! - [`named`]: every analysis by its name ([`named::parse`]), run to an [`Outcome`]: its
-//!   document and its arrays as layouts ([`Datasets`]); the one door of Python and WebAssembly.
+//! - [`named`]: every analysis by its name ([`named::parse`]) as a [`named::NamedRequest`];
+//!   the one door of Python and WebAssembly.
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason, and the budgets of
 //!   a request's cost ([`limits::Cost`]), which `costs` estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
-//! - [`checkpoint`]: what every study's store shares (its errors and ledger); with the feature
-//!   `files`, the CSV of a sweep's checkpoint (`checkpoint_file`), in a directory locked for
-//!   one run at a time ([`crate::io::dir_lock`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
 //! the library's parameter (`samples_per_period`) and a front end respells them
@@ -33,12 +30,8 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
-pub mod checkpoint;
-#[cfg(feature = "files")]
-pub(crate) mod checkpoint_file;
 pub(crate) mod costs;
 pub mod curves;
-mod datasets;
 #[cfg(feature = "files")]
 pub(crate) use crate::io::dir_lock;
 pub mod fm;
@@ -60,7 +53,6 @@ pub mod modes;
 pub mod named;
 pub mod peakforce;
 pub(crate) mod peakforce_sweep;
-pub(crate) mod pool;
 pub mod quantity;
 
 pub mod reconstruct;
@@ -85,9 +77,7 @@ pub use fit::FitRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};
-pub use named::{Datasets, Named, Outcome};
 pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
-pub(crate) use pool::in_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
     admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document,

@@ -4,15 +4,10 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::run::{Analysis, Request, Resolved};
-use crate::analysis::progress::Progress;
-use crate::eigen::{fig3_sweep, spectrum, Fig3Point, RegionSpectrum};
+use super::run::{Request, Resolved};
 use crate::error::SimError;
-use crate::params::Params;
-use crate::report;
-use crate::units::{PhysicalModel, Scales};
+use crate::units::PhysicalModel;
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
 
 /// The cost of a request that integrates nothing: the model's memory.
 const NO_WORK: Cost = Cost {
@@ -40,28 +35,6 @@ impl Request for ModesRequest {
     }
 }
 
-impl Analysis for ModesRequest {
-    type Output = (RegionSpectrum, RegionSpectrum);
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        Ok(spectrum(&model.params)?)
-    }
-    fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
-        Ok(report::modes(&model.params, free, contact))
-    }
-    fn present(
-        &self,
-        (free, contact): &Self::Output,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(crate::report::present::modes::modes(
-            &at.model.params,
-            free,
-            contact,
-            at.units,
-        ))
-    }
-}
-
 /// `modes --sweep fig3`: the paper's Fig. 3 maps, ω₁/ω₀₁ and ω₂/ω₀₂ of the contact system
 /// over the α1 × α4 grid (`crate::report::present::modes::fig3_alpha1` ×
 /// `crate::report::present::modes::fig3_alpha4`) at the model's N (`crate::eigen::fig3_sweep`).
@@ -82,34 +55,6 @@ impl Request for Fig3Request {
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         // 11 × 101 eigenproblems of 2N × 2N: no integration
         Ok(NO_WORK)
-    }
-}
-
-impl Analysis for Fig3Request {
-    type Output = Vec<Fig3Point>;
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        let (alpha1, alpha4) = (
-            crate::report::present::modes::fig3_alpha1(),
-            crate::report::present::modes::fig3_alpha4(),
-        );
-        Ok(fig3_sweep(model.params.modes, &alpha1, &alpha4)?)
-    }
-    fn report(&self, model: &Resolved, points: &Self::Output) -> Result<Value, SimError> {
-        Ok(json!({ "params": model.params, "points": points, "out": self.out }))
-    }
-    fn present(
-        &self,
-        points: &Self::Output,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        #[cfg(feature = "files")]
-        let mut shown = crate::report::present::modes::fig3(at.model.params.modes, points);
-        #[cfg(not(feature = "files"))]
-        let mut shown = report::Presentation::default();
-        let _ = at.model;
-        shown.summary = vec![format!("wrote {} points to", points.len())];
-        shown.outputs_note = report::OutputsNote::Named;
-        Ok(shown)
     }
 }
 
@@ -137,44 +82,6 @@ impl Request for UnitsRequest {
     }
 }
 
-impl Analysis for UnitsRequest {
-    /// The physical model's dimensionless set and scales (`None`: the probe's model).
-    type Output = Option<(Params, Scales)>;
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        match &self.physical {
-            Some(m) => Ok(Some((m.to_params()?, m.scales()))),
-            None => Ok(None),
-        }
-    }
-    fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError> {
-        Ok(match output {
-            Some((p, s)) => json!({ "params": p, "scales": s, "physical": self.physical }),
-            None => match &self.probe {
-                Some(pr) => {
-                    json!({ "params": pr.params, "si": report::si(pr, &pr.params, &json!({})) })
-                }
-                None => json!({ "params": model.params }),
-            },
-        })
-    }
-    fn present(
-        &self,
-        output: &Self::Output,
-        at: crate::request::Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(match (&self.physical, output) {
-            (Some(m), Some((p, s))) => crate::report::present::modes::units(m, p, s),
-            _ => {
-                let mut shown = report::Presentation::default();
-                shown.line(
-                    serde_json::to_string_pretty(at.document).expect("a document serialises"),
-                );
-                shown
-            }
-        })
-    }
-}
-
 /// `cantilevers`: the lever library (nominal k, f₀, Q and tip radius, with their sources;
 /// [`crate::cantilevers`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -189,22 +96,5 @@ impl Request for CantileversRequest {
     }
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         Ok(NO_WORK)
-    }
-}
-
-impl Analysis for CantileversRequest {
-    type Output = ();
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn report(&self, _: &Resolved, _: &()) -> Result<Value, SimError> {
-        Ok(crate::cantilevers::document())
-    }
-    fn present(
-        &self,
-        _: &(),
-        _: crate::request::Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(crate::report::present::modes::cantilevers())
     }
 }

@@ -594,7 +594,7 @@ fn units_block(si: bool) -> Value {
     }
 }
 
-impl super::named::Datasets for PeakForceRequest {
+impl crate::study::named::Datasets for PeakForceRequest {
     /// `cycle` (time, deflection, distance, force over one period from the largest
     /// separation) and `curve` (approach and retract, each over its own dimension), in the
     /// document's units; the channels as facts.
@@ -602,7 +602,7 @@ impl super::named::Datasets for PeakForceRequest {
         &self,
         model: &Resolved,
         r: &PeakForceResult,
-    ) -> Result<super::named::Arrays, SimError> {
+    ) -> Result<crate::study::named::Arrays, SimError> {
         use crate::layout::{Layout, Variable};
         let doc = document(self, model, r);
         let units = &doc["units"];

@@ -5,15 +5,15 @@
 //! Every analysis whose result is one value implements [`Analysis`]: `modes`, `orbit`,
 //! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`,
 //! and the studies that run in memory here and resumably in a front end's store — `basins`,
-//! `attractors --sweep`, `approach` and `resonance` (their `Analysis` is beside the study, in
-//! `crate::study::basins`, `crate::study::global_continuation` and `crate::study::stepped`).
-//! The two whose results are streams enter through it too: `simulate` streamed to files
+//! `attractors --sweep`, `approach` and `resonance`. What a request is ([`Request`]: its
+//! checks and declared cost) is here, beside the requests; how it runs (every `Analysis`
+//! implementation) is the study layer's (`crate::study`). The two whose results are streams
+//! enter through it too: `simulate` streamed to files
 //! ([`crate::request::simulate_stream::SimulateStream`]: recorded in chunks by
 //! `crate::trajectory::chunked::record_chunked`, its series' bytes held against the files'
 //! budget, [`crate::request::analyses::SimulateSpan`]), and `bifurcation`, whose `execute` is
 //! the in-memory sweep; a front end that runs the sweep resumably into a store of its own
-//! ([`crate::study::sweep::SweepStudy`] into its checkpoint) checks its cost
-//! first by [`admit`].
+//! (the sweep's study into its checkpoint) checks its cost first by [`admit`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
 //! their units of work in it (random starts, curve and branch points, drive periods, mode
@@ -22,26 +22,20 @@
 
 use super::analyses::{
     AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
-    ObserveResult, OrbitRequest,
+    OrbitRequest,
 };
-use super::costs::{census_cost, converge_cost};
+use super::costs::{census_cost, converge_cost, stepped_cost};
 use super::costs::{check_cost, newton_work, start_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
 use super::limits::CASCADE_FACTOR;
-use crate::analysis::attractors::AttractorReport;
-use crate::analysis::continuation::Branch;
 use crate::analysis::continuation::ContinuationSpec;
-use crate::analysis::converge::ConvergenceRun;
-use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
 use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
-use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::{self, CurveUnits};
@@ -230,7 +224,7 @@ pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(),
 ///
 /// # Errors
 /// As [`admit`], less the budget's.
-pub(crate) fn validate<A: Analysis + ?Sized>(
+pub(crate) fn validate<A: Request + ?Sized>(
     analysis: &A,
     model: &Resolved,
 ) -> Result<(), SimError> {
@@ -287,23 +281,6 @@ impl Request for OrbitRequest {
     }
 }
 
-impl Analysis for OrbitRequest {
-    type Output = PeriodicOrbit;
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
-        self.run(&model.params)
-    }
-    fn report(&self, model: &Resolved, o: &PeriodicOrbit) -> Result<Value, SimError> {
-        Ok(report::orbit(&CantileverModel::new(&model.params)?, o))
-    }
-    fn present(
-        &self,
-        output: &Self::Output,
-        at: Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        crate::report::present::orbits::orbit(&at.model.params, output, at.units)
-    }
-}
-
 impl Request for ContinuationRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         ContinuationRequest::validate(self, &model.params)
@@ -332,30 +309,6 @@ impl Request for ContinuationRequest {
     }
 }
 
-impl Analysis for ContinuationRequest {
-    type Output = Vec<Branch>;
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
-    }
-    fn report(&self, model: &Resolved, branches: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::continuation(&model.params, self.param, branches))
-    }
-    #[cfg(feature = "files")]
-    fn present(
-        &self,
-        branches: &Self::Output,
-        at: Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        crate::report::present::continuation::continuation(
-            &at.model.params,
-            self.param,
-            self.from,
-            branches,
-            at.units,
-        )
-    }
-}
-
 impl Request for LyapunovRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         LyapunovRequest::validate(self)
@@ -379,27 +332,6 @@ impl Request for LyapunovRequest {
     }
 }
 
-impl Analysis for LyapunovRequest {
-    type Output = LyapunovSpectrum;
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
-    }
-    fn report(&self, model: &Resolved, l: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::lyapunov(&model.params, l))
-    }
-    fn present(
-        &self,
-        output: &Self::Output,
-        at: Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(crate::report::present::orbits::lyapunov(
-            &at.model.params,
-            output,
-            at.units,
-        ))
-    }
-}
-
 impl Request for AttractorsRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
@@ -410,33 +342,6 @@ impl Request for AttractorsRequest {
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         let spec = self.spec(&model.params)?;
         census_cost(&spec, 1)
-    }
-}
-
-impl Analysis for AttractorsRequest {
-    type Output = AttractorReport;
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
-    }
-    fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::attractors(&model.params, self.samples, r))
-    }
-    #[cfg(feature = "files")]
-    fn present(
-        &self,
-        r: &Self::Output,
-        at: Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        let spec = self.spec(&at.model.params)?;
-        let mut shown =
-            crate::report::present::census::attractors(&spec, r, at.document, at.units)?;
-        shown
-            .warnings
-            .extend(crate::report::present::census::failed_starts(
-                r,
-                self.samples,
-            ));
-        Ok(shown)
     }
 }
 
@@ -464,19 +369,6 @@ impl Request for ObserveRequest {
     }
 }
 
-impl Analysis for ObserveRequest {
-    type Output = ObserveResult;
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params)
-    }
-    fn report(&self, model: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
-        let units = CurveUnits::of(model.probe.as_ref(), false);
-        let mut doc = report::observables(&o.observables);
-        doc["reported"] = report::observed(&o.observables, &units);
-        Ok(doc)
-    }
-}
-
 impl Request for ConvergeRequest {
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ConvergeRequest::validate(self)
@@ -486,31 +378,6 @@ impl Request for ConvergeRequest {
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         converge_cost(self, &model.params)
-    }
-}
-
-impl Analysis for ConvergeRequest {
-    type Output = Vec<ConvergenceRun>;
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        self.run(&model.params, progress)
-    }
-    fn report(&self, model: &Resolved, runs: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::converge(&model.params, runs))
-    }
-    #[cfg(feature = "files")]
-    fn present(
-        &self,
-        runs: &Self::Output,
-        at: Presenting<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        let mut shown = crate::report::present::converge::converge(&at.model.params, runs);
-        // the printed document names the output directory
-        if let Some(dir) = at.to.dir {
-            let mut document = at.document.clone();
-            document["out"] = serde_json::json!(dir);
-            shown.document = Some(document);
-        }
-        Ok(shown)
     }
 }
 
@@ -635,49 +502,48 @@ impl ResonanceRequest {
 #[serde(transparent)]
 pub struct Bimodal(pub ApproachRequest);
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The document of `run` is the report of the typed result with the SI block, and a
-    /// cancelled progress stops a run before it starts.
-    #[test]
-    fn run_builds_the_reports_document_and_honours_cancel() {
-        let model = Resolved::plain(Params {
-            omega: 2.8,
-            ..Params::default()
-        });
-        let request = OrbitRequest::default();
-        let progress = Progress::new();
-        let doc = run(&request, &model, &progress).unwrap();
-        let want = report::orbit(&CantileverModel::new(&model.params).unwrap(), &doc.output);
-        assert_eq!(doc.json, want);
-        assert_eq!(doc.output.period, 2);
-        progress.cancel();
-        assert!(matches!(
-            run(&request, &model, &progress),
-            Err(SimError::Cancelled)
-        ));
+impl Request for ApproachRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
     }
+    fn name(&self) -> &'static str {
+        "approach"
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
+    }
+}
 
-    /// Counted analyses count: the attractor census ticks once per random start, and a
-    /// cancel between starts ends it with `Cancelled`.
-    #[test]
-    fn attractors_count_their_starts() {
-        let model = Resolved::plain(Params::default());
-        let request = AttractorsRequest {
-            samples: 6,
-            ..AttractorsRequest::default()
-        };
-        let progress = Progress::new();
-        let doc = run(&request, &model, &progress).unwrap();
-        assert_eq!((progress.done(), progress.total()), (6, Some(6)));
-        assert_eq!(doc.json["samples"], 6);
-        // cancelled before the starts: every start is refused and the census with it
-        let cancelled = Progress::new();
-        cancelled.cancel();
-        let err = request.execute(&model, &cancelled).unwrap_err();
-        assert!(matches!(err, SimError::Cancelled), "{err}");
-        assert_eq!(cancelled.done(), 6);
+impl Request for ResonanceRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "resonance"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
+    }
+}
+
+impl Request for Bimodal {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        self.0.validate(model)
+    }
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        self.0.cost(model)
     }
 }

@@ -1,13 +1,11 @@
 //! The `simulate` request ([`SimulateRequest`]): one trajectory recorded after a transient,
 //! its span and its budget by where the series goes ([`SeriesStore`], [`SimulateSpan`]).
 
-use super::analyses::{check_samples_per_period, initial_state, IntegratorRequest};
+use super::analyses::{check_samples_per_period, IntegratorRequest};
 use super::limits::*;
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorOptions};
-use crate::model::CantileverModel;
+use crate::integrate::IntegratorOptions;
 use crate::params::Params;
-use crate::trajectory::{record, RecordSpec, Trajectory};
 use serde::{Deserialize, Serialize};
 
 /// Where a recorded time series goes, which sets its budget.
@@ -178,30 +176,5 @@ impl SimulateRequest {
     /// As [`SimulateRequest::validate`].
     pub fn validate_in_memory(&self, params: &Params) -> Result<SimulateSpan, SimError> {
         self.validate(params, SeriesStore::Memory, 7 + params.state_dim(), 8.0)
-    }
-
-    /// Record the run of `model` over `span` (validated, [`SimulateRequest::validate_in_memory`])
-    /// whole in memory ([`crate::trajectory::record`]: samples, switchings, sections, the energy
-    /// balance per period and the body-contact check), from the request's initial state (rest
-    /// when none): the trajectory and the integrator's name.
-    ///
-    /// # Errors
-    /// The initial state's ([`super::analyses::initial_state`]), the integrator's.
-    pub fn record_whole(
-        &self,
-        model: &CantileverModel,
-        span: &SimulateSpan,
-    ) -> Result<(Trajectory, &'static str), SimError> {
-        let z0 = initial_state(model, self.initial.as_deref())?;
-        let mut integ = build(model, self.integrator_options()?, 0.0, &z0)?;
-        let spec = RecordSpec {
-            transient_periods: self.transient,
-            record_tau: span.record_tau,
-            samples_per_period: self.samples_per_period,
-            energy: true,
-            body_contact: true,
-        };
-        let tr = record(integ.as_mut(), &spec)?;
-        Ok((tr, integ.name()))
     }
 }

@@ -105,3 +105,7 @@ pub fn first_difference(then: &Value, now: &Value) -> Option<(String, String, St
     }
     walk("", Some(then), Some(now))
 }
+/// The number of points of a sweep: values × (2 with continuation + random starts).
+pub fn point_count(spec: &SweepSpec) -> usize {
+    spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize)
+}

@@ -112,7 +112,7 @@ impl Analysis for BasinsRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
         let study = BasinStudy::new(self, &model.params)?;
         let records = execute_in_memory(&study.chain(), self.threads, progress)?;
-        crate::request::in_pool(self.threads, || {
+        crate::study::in_pool(self.threads, || {
             study.map(records.into_iter().map(|(_, r)| r))
         })
     }

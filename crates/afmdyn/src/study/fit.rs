@@ -23,8 +23,8 @@ use crate::probe::ranges::si_range;
 use crate::probe::SampleInputs;
 use crate::request::fit::{bad, check_columns, FitRequest};
 use crate::request::fit_result::{probe_value, AmData, MIN_FIT_ROWS};
-use crate::request::named::{Arrays, Datasets};
 use crate::request::run::{Analysis, Resolved};
+use crate::study::named::{Arrays, Datasets};
 use serde_json::{json, Value};
 
 /// How a fit's intervals were found, for its document's `method`: the profile likelihood's

@@ -9,8 +9,8 @@ use crate::error::SimError;
 use crate::layout::columns::{self, columns, Column, UnitNames};
 use crate::report::CurveUnits;
 use crate::request::fm::FmRequest;
-use crate::request::named::{Arrays, Datasets};
 use crate::request::run::{Analysis, Resolved};
+use crate::study::named::{Arrays, Datasets};
 use serde_json::{json, Value};
 
 impl Analysis for FmRequest {

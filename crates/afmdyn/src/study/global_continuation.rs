@@ -20,8 +20,7 @@ use crate::error::SimError;
 use crate::params::Params;
 use crate::report;
 use crate::request::costs::{census_cost, check_cost};
-use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Request, Resolved};
+use crate::request::run::{Analysis, Resolved};
 use crate::request::GlobalContinuationRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -95,20 +94,6 @@ impl ContinuationStudy {
             continue_values(&self.spec, done, cancel, &store).map(|_| ())
         };
         Chain::new(&self.fingerprint, self.spec.values.len(), run).weighted(units, move |_| samples)
-    }
-}
-
-impl Request for GlobalContinuationRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "attractors --sweep"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // one census per value
-        let spec = self.spec(&model.params)?;
-        census_cost(&spec.census, spec.values.len())
     }
 }
 

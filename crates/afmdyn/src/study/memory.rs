@@ -2,7 +2,7 @@
 //! page's bifurcation sweep run chunk by chunk, each chunk a resume of the one before).
 
 use super::{Opened, Resumes, Store, Study};
-use crate::request::checkpoint::{same_request, CheckpointError, Ledger};
+use crate::study::checkpoint::{same_request, CheckpointError, Ledger};
 
 /// The finished tasks of a study, in the order they finished until the study finishes (then in
 /// its one order, [`Study::order`]), and the ledger of the run that made them: a resume of the

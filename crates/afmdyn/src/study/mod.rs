@@ -36,6 +36,12 @@
 //!   `fit_dynamic` (a force curve's and a dynamic curve's fit), `fm` (an FM curve) and
 //!   `reconstruct` (the force behind an FM or AM curve, and `reconstruct_document`'s run).
 //!
+//! - the running of the requests (`crate::request` holds what they are): the one-value
+//!   analyses' `Analysis` (`analyses`, `modes`), `simulate` recorded whole (`simulate`) or
+//!   streamed to files (`simulate_stream`), a request run by its name to its outcome
+//!   ([`named`], its arrays `datasets`), and what the stores share ([`checkpoint`], with the
+//!   sweep's checkpoint file `checkpoint_file`) and the worker pool (`pool`).
+//!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
 //!
@@ -44,10 +50,15 @@
 //! finishes. Dask (`afmdyn.dask`) is another executor of the same tasks: it ships them to
 //! workers and writes through the same layout.
 
+pub(crate) mod analyses;
 pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
+pub mod checkpoint;
+#[cfg(feature = "files")]
+pub(crate) mod checkpoint_file;
+mod datasets;
 pub(crate) mod fit;
 pub(crate) mod fit_dynamic;
 pub(crate) mod fm;
@@ -55,14 +66,20 @@ pub mod global_continuation;
 pub(crate) mod image;
 mod kinds;
 mod memory;
+pub(crate) mod modes;
+pub mod named;
 pub(crate) mod peakforce;
 pub(crate) mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
+pub(crate) mod pool;
 pub(crate) mod reconstruct;
 pub mod scan;
 #[cfg(feature = "files")]
 pub(crate) mod scan_store;
+pub(crate) mod simulate;
+#[cfg(feature = "files")]
+pub mod simulate_stream;
 pub mod stepped;
 #[cfg(feature = "files")]
 pub mod stored;
@@ -70,12 +87,14 @@ pub mod sweep;
 #[cfg(feature = "files")]
 pub(crate) mod task_store;
 
+pub use analyses::advance_from_rest;
 pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
+pub(crate) use pool::in_pool;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::checkpoint::CheckpointError;
+use crate::study::checkpoint::CheckpointError;
 use serde_json::Value;
 use std::collections::{BTreeMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -309,7 +328,7 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
         drop(guard);
         observer.stored(units, count.fetch_add(1, Ordering::SeqCst) + 1);
     };
-    let ran = crate::request::in_pool(threads, || study.run(&done, &sink, cancel));
+    let ran = crate::study::in_pool(threads, || study.run(&done, &sink, cancel));
     let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
     if let Some(e) = failed {
         return Err(e.into());

@@ -20,6 +20,7 @@
 //! plan's: the executor only maps tasks and hands results back.
 
 use super::basins::BasinStudy;
+use super::named::{outcome, Outcome};
 use super::stored::sweep_outcome;
 use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
@@ -34,7 +35,6 @@ use crate::request::image::{ImageRequest, SampleMap};
 use crate::request::image_job::ImageKeywords;
 use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
 use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
-use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
 use crate::request::{BasinsRequest, BifurcationRequest, DirLock, Resolved};
 use crate::Params;
@@ -427,7 +427,7 @@ impl PlanStore for SweepStore {
         Ok(self.checkpoint().finish(&self.fingerprint)?)
     }
     fn outcome(&mut self) -> Result<Outcome, StudyError> {
-        let recs = crate::request::checkpoint_file::final_rows(self.lock.path())?;
+        let recs = crate::study::checkpoint_file::final_rows(self.lock.path())?;
         if let Some(e) = every_point_failed(&recs) {
             return Err(e.into());
         }

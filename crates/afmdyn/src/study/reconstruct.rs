@@ -10,12 +10,12 @@ use crate::analysis::reconstruct_exact::exact_inversion;
 use crate::error::SimError;
 use crate::layout::Layout;
 use crate::report::present::reconstruct::{reconstruction, Inversion};
-use crate::request::named::{Arrays, Datasets};
 use crate::request::reconstruct::{
     am_curve_from_approach, AmReconstruction, FmInversion, ReconstructRequest,
 };
 use crate::request::reconstruct_document::{self, FromDocument};
 use crate::request::run::{run, Analysis, Resolved};
+use crate::study::named::{Arrays, Datasets};
 use serde_json::{json, Value};
 
 impl Analysis for ReconstructRequest {

@@ -20,11 +20,9 @@ use crate::analysis::stepped::{
     check_values, finish_curve, sweep_points, CurvePoint, SteppedCurve, SteppedSpec,
 };
 use crate::error::SimError;
-use crate::params::Params;
 use crate::report;
 use crate::report::present::curves::{stepped, CurveKind};
 use crate::request::costs::{check_cost, stepped_cost};
-use crate::request::limits::Cost;
 use crate::request::run::{
     Analysis, ApproachRequest, Bimodal, Request, Resolved, ResonanceRequest,
 };
@@ -158,21 +156,6 @@ macro_rules! present_curve {
     };
 }
 
-impl Request for ApproachRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "approach"
-    }
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Tapping
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        stepped_cost(&self.spec(model)?)
-    }
-}
-
 impl Analysis for ApproachRequest {
     type Output = SteppedCurve;
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
@@ -205,21 +188,6 @@ impl Analysis for ApproachRequest {
         Some(c.largest_indentation())
     }
     present_curve!(CurveKind::Approach);
-}
-
-impl Request for ResonanceRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "resonance"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        stepped_cost(&self.spec(model)?)
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
-    }
 }
 
 impl Analysis for ResonanceRequest {
@@ -301,21 +269,6 @@ fn soft_sample_warning(
         crate::error::number(z),
         if u.si { "m" } else { "g0" },
     ))
-}
-impl Request for Bimodal {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        crate::request::curves::check_bimodal(&model.params)?;
-        self.0.validate(model)
-    }
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Tapping
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        self.0.cost(model)
-    }
 }
 
 impl Analysis for Bimodal {

@@ -5,12 +5,13 @@
 //! by name ([`parse`]: `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`,
 //! `resonance`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
 //! ([`Prepared::run`]) to the outcome the one door gives for the same request
-//! (`crate::request::named::outcome`).
+//! (`super::named::outcome`).
 
 use super::basins::{basin_store, BasinStudy};
 use super::chart::cells_of;
 use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
+use super::named::{self, Datasets, Outcome};
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
 use super::sweep::{sweep_checkpoint, SweepStudy};
@@ -22,11 +23,8 @@ use crate::analysis::stepped::SteppedCurve;
 use crate::error::SimError;
 use crate::report::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, SweepTally};
 use crate::request::chart::Chart;
-use crate::request::checkpoint::CheckpointError;
-use crate::request::checkpoint_file::{each_row, final_csv, final_rows, write_npy};
 use crate::request::image_job::{ImageJob, ImageOutput};
 use crate::request::image_scan::ScanStudy;
-use crate::request::named::{self, Datasets, Outcome};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
 use crate::request::GlobalContinuationRequest;
@@ -34,6 +32,8 @@ use crate::request::{
     Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock, Request,
 };
 use crate::request::{Resolved, ResonanceRequest};
+use crate::study::checkpoint::CheckpointError;
+use crate::study::checkpoint_file::{each_row, final_csv, final_rows, write_npy};
 use serde::de::{DeserializeOwned, Deserializer};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -233,7 +233,7 @@ impl Resumable for BasinsRequest {
     ) -> Result<Self::Output, StudyError> {
         let rows = storage.records(&study.chain(), basin_store, self.threads, progress)?;
         let map = || study.map(rows.into_iter().map(|(_, r)| r));
-        Ok(crate::request::in_pool(self.threads, map)?)
+        Ok(crate::study::in_pool(self.threads, map)?)
     }
 }
 

@@ -8,12 +8,11 @@ use super::{Resumes, Study};
 use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::checkpoint::{end_state, point_count};
-use crate::request::costs::{state_bytes, steady_periods, MODEL_BYTES};
-use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Request, Resolved};
+use crate::request::run::{Analysis, Resolved};
+use crate::request::sweep::point_count;
 use crate::request::sweep::{records, SweepRecord};
 use crate::request::BifurcationRequest;
+use crate::study::checkpoint::end_state;
 use serde_json::Value;
 use std::sync::atomic::AtomicBool;
 
@@ -83,39 +82,6 @@ impl Study for SweepStudy {
 /// the one order (`crate::request::sweep::order_key`). A front end that runs the sweep
 /// resumably into a store of its own (`afmdyn bifurcation --out DIR`) checks the same cost
 /// first ([`crate::request::run::admit`]) and runs the [`SweepStudy`] itself.
-impl Request for BifurcationRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "bifurcation"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // every point (each value reached forward, backward and from each random start) and
-        // each continued branch's coarse pass over its chunks (at most one point a value):
-        // the steady-state search to its transient cap, then the recorded periods (one cycle
-        // of up to max_period, or nonperiodic_record), whose Poincaré points are the records
-        let spec = self.spec(&model.params)?;
-        let p = &spec.base;
-        let values = spec.values.len() as f64;
-        let points = crate::request::checkpoint::point_count(&spec) as f64;
-        let coarse = if spec.continuation { 2.0 * values } else { 0.0 };
-        let recorded = spec.steady.max_period.max(spec.steady.nonperiodic_record) as f64;
-        // the transient cap at the range's ends (a model's decay, and with it the cap, moves
-        // monotonically with one parameter)
-        let (lo, hi) = (spec.values.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |b, &v| {
-            (b.0.min(v), b.1.max(v))
-        });
-        let cap = steady_periods(&spec.steady, &p.with(spec.param, lo))?
-            .max(steady_periods(&spec.steady, &p.with(spec.param, hi))?);
-        let record = std::mem::size_of::<SweepRecord>() as f64 + state_bytes(p) + 64.0;
-        Ok(Cost {
-            bytes: MODEL_BYTES + points * recorded * record,
-            work: (points + coarse) * (cap + recorded) * p.modes as f64,
-        })
-    }
-}
-
 impl Analysis for BifurcationRequest {
     type Output = Vec<SweepRecord>;
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
@@ -159,7 +125,7 @@ impl Resumes<Vec<SweepRecord>> for Resume {
 
 /// The codec of a sweep's checkpoint (the directory's `.bifurcation.run.json` and
 /// `.bifurcation.partial.csv`, its rows put in the one order in `bifurcation.csv` when the
-/// sweep finishes: `crate::request::checkpoint_file`), a point's rows stored together.
+/// sweep finishes: `crate::study::checkpoint_file`), a point's rows stored together.
 #[cfg(feature = "files")]
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SweepRows;
@@ -169,7 +135,7 @@ impl super::task_store::Codec for SweepRows {
     type Record = Vec<SweepRecord>;
 
     fn layout(&self) -> super::task_store::Layout {
-        use crate::request::checkpoint_file::{FINAL_CSV, LEDGER, PARTIAL_CSV};
+        use crate::study::checkpoint_file::{FINAL_CSV, LEDGER, PARTIAL_CSV};
         super::task_store::Layout {
             ledger: LEDGER,
             records: PARTIAL_CSV,
@@ -181,11 +147,11 @@ impl super::task_store::Codec for SweepRows {
     }
 
     fn header(&self) -> Option<String> {
-        Some(crate::request::checkpoint_file::partial_header())
+        Some(crate::study::checkpoint_file::partial_header())
     }
 
     fn encode(&self, point: &Vec<SweepRecord>) -> Result<String, String> {
-        let seal = |r: &SweepRecord| crate::request::checkpoint_file::sealed(&r.csv_line()) + "\n";
+        let seal = |r: &SweepRecord| crate::study::checkpoint_file::sealed(&r.csv_line()) + "\n";
         Ok(point.iter().map(seal).collect())
     }
 
@@ -193,15 +159,15 @@ impl super::task_store::Codec for SweepRows {
         &self,
         path: &std::path::Path,
         each: &mut dyn FnMut(Vec<SweepRecord>),
-    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
-        crate::request::checkpoint_file::read_points(path, each)
+    ) -> Result<(), crate::study::checkpoint::CheckpointError> {
+        crate::study::checkpoint_file::read_points(path, each)
     }
 
     fn finish(
         &self,
         dir: &std::path::Path,
-    ) -> Result<(), crate::request::checkpoint::CheckpointError> {
-        crate::request::checkpoint_file::sort_into_final(dir)
+    ) -> Result<(), crate::study::checkpoint::CheckpointError> {
+        crate::study::checkpoint_file::sort_into_final(dir)
     }
 }
 

@@ -25,9 +25,9 @@
 
 use crate::io::dir_lock::DirLock;
 use crate::io::input::InputKind;
-use crate::request::checkpoint::{same_request, CheckpointError, Ledger};
-use crate::request::checkpoint_file::{crc_hex, io, open_store, read_failed, read_ledger};
-use crate::request::checkpoint_file::{write_atomic, START_OVER};
+use crate::study::checkpoint::{same_request, CheckpointError, Ledger};
+use crate::study::checkpoint_file::{crc_hex, io, open_store, read_failed, read_ledger};
+use crate::study::checkpoint_file::{write_atomic, START_OVER};
 use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine;
 use serde::de::DeserializeOwned;

@@ -277,7 +277,7 @@ pub struct SweepFiles {
 }
 
 /// A diagram's points, streamed from the store's CSV ([`diagram_point`] of each row, read by
-/// the store: `crate::request::checkpoint_file`): the memory of a large sweep's figures stays
+/// the store: `crate::study::checkpoint_file`): the memory of a large sweep's figures stays
 /// bounded.
 #[cfg(feature = "files")]
 #[derive(Debug)]

@@ -167,10 +167,6 @@ pub fn initial_state(
     Ok(state)
 }
 
-/// [`StartRequest::guess_with_section`]: the guess, the period found, the recorded section
-/// points (each of shape `[2N]`).
-pub(crate) type GuessWithSection = (DVector<f64>, Option<usize>, Vec<DVector<f64>>);
-
 /// Where an orbit analysis starts: a given state, or the steady state reached from rest.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -184,18 +180,6 @@ pub struct StartRequest {
 }
 
 impl StartRequest {
-    /// The guess and, when a steady state was searched, its period.
-    ///
-    /// # Errors
-    /// As [`initial_state`], [`SteadyRequest::options`] and [`steady_state`].
-    pub(crate) fn guess(
-        &self,
-        model: &CantileverModel,
-    ) -> Result<(DVector<f64>, Option<usize>), SimError> {
-        let (z, found, _) = self.guess_with_section(model)?;
-        Ok((z, found))
-    }
-
     /// The longest period and the transient cap (drive periods) of the steady-state search
     /// [`Self::guess`] runs from this start on `model`; `None` for a given `initial` state
     /// (not searched).
@@ -211,26 +195,5 @@ impl StartRequest {
             .initial
             .is_none()
             .then(|| (steady.max_period, steady.cap(model))))
-    }
-
-    /// [`Self::guess`] with the section points the steady-state search recorded (z(kT) of
-    /// consecutive drive periods, the last one the guess; empty for a given `initial`): the
-    /// starts of [`crate::analysis::shooting::Guess::Section`] when Newton from the guess fails.
-    ///
-    /// # Errors
-    /// As [`Self::guess`].
-    pub(crate) fn guess_with_section(
-        &self,
-        model: &CantileverModel,
-    ) -> Result<GuessWithSection, SimError> {
-        let steady = self.steady.options()?;
-        let z0 = initial_state(model, self.initial.as_deref())?;
-        if self.initial.is_some() {
-            return Ok((z0, None, Vec::new()));
-        }
-        let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
-        let s = steady_state(integ.as_mut(), &steady)?;
-        let section = s.poincare.iter().map(|p| p.state.clone()).collect();
-        Ok((s.end_state().clone(), s.period(), section))
     }
 }

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::layout::{Layout, Values, Variable};
-use crate::request::named::Outcome;
+use crate::study::named::Outcome;
 
 /// The most setpoints of a setpoint study, on every front end: each is a line engaged on
 /// the background that crosses every domain.

@@ -6,10 +6,11 @@ use crate::analysis::bifurcation::Branch;
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::params::Params;
-use crate::request::checkpoint::*;
+use crate::request::sweep::point_count;
 use crate::request::sweep::SweepRecord;
 use crate::request::sweep::{order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
+use crate::study::checkpoint::*;
 use crate::study::{execute, MemoryStore, Opened, Store, StudyError};
 use std::collections::HashSet;
 use std::sync::Mutex;
@@ -260,8 +261,8 @@ fn records_without_a_ledger_are_not_resumed() {
 #[test]
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     use crate::io::dir_lock::DirLock;
-    use crate::request::checkpoint_file::{final_rows, LEDGER, PARTIAL_CSV};
     use crate::request::sweep::fingerprint;
+    use crate::study::checkpoint_file::{final_rows, LEDGER, PARTIAL_CSV};
     use crate::study::task_store::TaskStore;
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);

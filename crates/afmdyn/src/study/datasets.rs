@@ -3,20 +3,20 @@
 //! The stepped curves' layouts are laid out from their documents (`fm`'s and `reconstruct`'s
 //! where they run).
 
-use super::modes::ModesRequest;
 use super::named::Datasets;
-use super::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
-use super::BasinArrays;
-use super::{
-    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
-    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
-};
 use crate::analysis::steady::SteadyState;
 use crate::eigen::RegionSpectrum;
 use crate::error::SimError;
 use crate::layout::{Layout, Values, Variable};
 use crate::model::CantileverModel;
 use crate::report;
+use crate::request::modes::ModesRequest;
+use crate::request::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
+use crate::request::BasinArrays;
+use crate::request::{
+    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
+    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
+};
 use nalgebra::DVector;
 use serde_json::{json, Map, Value};
 
@@ -133,7 +133,7 @@ impl Datasets for ObserveRequest {
     /// The observables' layout from the document (`crate::report::curve_layout::observe_layout`)
     /// and the period.
     fn datasets(&self, model: &Resolved, o: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, o)?;
+        let doc = crate::request::run::document(self, model, o)?;
         let layout =
             crate::report::curve_layout::observe_layout(&doc, o.state.as_slice(), o.period);
         Ok((
@@ -321,7 +321,7 @@ impl Datasets for GlobalContinuationRequest {
 impl Datasets for ApproachRequest {
     /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, curve)?;
+        let doc = crate::request::run::document(self, model, curve)?;
         one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }
@@ -329,7 +329,7 @@ impl Datasets for ApproachRequest {
 impl Datasets for ResonanceRequest {
     /// The curve's layout from its document (`crate::report::curve_layout::curve_layout`).
     fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
-        let doc = super::run::document(self, model, curve)?;
+        let doc = crate::request::run::document(self, model, curve)?;
         one("curve", crate::report::curve_layout::curve_layout(&doc))
     }
 }

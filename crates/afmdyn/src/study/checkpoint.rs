@@ -1,12 +1,11 @@
-//! What every store of a study shares (its stores are `crate::study`'s: in memory, or with
+//! What every store of a study shares (its stores, beside it here: in memory, or with
 //! the `files` feature a directory): its errors ([`CheckpointError`]), its ledger ([`Ledger`]:
 //! the fingerprint of the request that made it — a resume of another request is refused,
 //! naming the first field that differs — and whether it finished), and of a bifurcation
-//! sweep's checkpoint the number of its points and the state a stored point's chain goes on
+//! sweep's checkpoint the state a stored point's chain goes on
 //! from.
 
-use super::sweep::{first_difference, SweepRecord};
-use crate::analysis::bifurcation::SweepSpec;
+use crate::request::sweep::{first_difference, SweepRecord};
 use nalgebra::DVector;
 use serde_json::Value;
 use thiserror::Error;
@@ -84,15 +83,10 @@ pub(crate) fn same_request(
     }
 }
 
-/// The number of points of a sweep: values × (2 with continuation + random starts).
-pub fn point_count(spec: &SweepSpec) -> usize {
-    spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize)
-}
-
 /// The continuation state of a stored point: the state of its last record, unless it failed.
 pub(crate) fn end_state(point: &[SweepRecord]) -> Option<DVector<f64>> {
     point
         .last()
-        .filter(|r| r.status != super::sweep::PointStatus::Error && !r.state.is_empty())
+        .filter(|r| r.status != crate::request::sweep::PointStatus::Error && !r.state.is_empty())
         .map(|r| DVector::from_vec(r.state.clone()))
 }

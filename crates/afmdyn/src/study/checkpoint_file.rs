@@ -16,14 +16,14 @@
 //! `afmdyn.bifurcation(store=DIR)` uses the same, so either resumes the other's sweep.
 
 use super::checkpoint::CheckpointError;
-use super::dir_lock::partial_path;
-use super::sweep::{branch_code, status_code, SweepRecord, HEADER, NUMERIC_COLUMNS};
-use super::sweep::{COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT, COL_POINTS, COL_STATUS};
-use super::sweep::{COL_TAU, COL_VALUE, COL_W_TIP, COL_X_MAX};
 use crate::analysis::bifurcation::Branch;
+use crate::io::dir_lock::partial_path;
 use crate::io::input::{open_existing, refusal, Bounded, InputFileError, InputKind};
 use crate::layout::files::{io_error, Column, FileError, NpyStream};
 use crate::params::SweepParam;
+use crate::request::sweep::{branch_code, status_code, SweepRecord, HEADER, NUMERIC_COLUMNS};
+use crate::request::sweep::{COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT, COL_POINTS, COL_STATUS};
+use crate::request::sweep::{COL_TAU, COL_VALUE, COL_W_TIP, COL_X_MAX};
 use serde_json::Value;
 use std::collections::HashSet;
 use std::fs::{self, File};
