@@ -11,9 +11,9 @@ use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
 use afmdyn::request::image::{ImageRequest, SampleMap};
 use afmdyn::request::image_job::{ImageJob, ImageMode, ImageOutput};
-use afmdyn::request::image_peakforce::PeakForceImage;
 use afmdyn::request::{PeakForceRequest, Resolved};
 use afmdyn::study::peakforce_image::peakforce_image;
+use afmdyn::study::peakforce_image::PeakForceImage;
 
 /// The setpoint (N).
 const SETPOINT: f64 = 2e-9;

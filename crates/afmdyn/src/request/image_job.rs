@@ -6,13 +6,13 @@
 
 use super::image::{background_probe, Image, ImageRequest, SampleMap, SetpointStudy};
 use super::image_options::GivenOptions;
-use super::image_peakforce::PeakForceImage;
 use super::image_scan::{PiImage, PiScan};
 #[cfg(feature = "files")]
 use super::image_scan::{ScanRecipe, ScanStudy};
 use super::named::Outcome;
 use super::run::Resolved;
 use crate::error::SimError;
+use crate::report::image::PeakForceImage;
 use serde::{Deserialize, Serialize};
 
 pub use super::image_options::ImageMode;

@@ -49,7 +49,8 @@ pub(crate) mod image;
 mod kinds;
 mod memory;
 pub(crate) mod peakforce;
-pub(crate) mod peakforce_image;
+pub mod peakforce_image;
+pub(crate) mod peakforce_sweep;
 #[cfg(feature = "files")]
 pub mod plan;
 pub mod scan;
@@ -64,6 +65,7 @@ pub(crate) mod task_store;
 
 pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
+pub use peakforce::PeakForceResult;
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;

@@ -20,6 +20,7 @@
 //! plan's: the executor only maps tasks and hands results back.
 
 use super::basins::BasinStudy;
+use super::peakforce_image::{Engage, LinePixel, PeakForceImageStudy};
 use super::stored::sweep_outcome;
 use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
@@ -32,7 +33,6 @@ use crate::error::SimError;
 use crate::request::image::{ImageRequest, SampleMap};
 #[cfg(feature = "files")]
 use crate::request::image_job::ImageKeywords;
-use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
 use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
 use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
