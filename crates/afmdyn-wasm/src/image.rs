@@ -23,9 +23,10 @@
 //! `curve_points`, `setpoint_study` or PI feedback with it.
 
 use afmdyn::probe::Probe;
-use afmdyn::request::image::{image as ideal_image, setpoint_study, study_ratios};
+use afmdyn::request::image::study_ratios;
 use afmdyn::request::image::{ImageRequest, SampleMap};
 use afmdyn::request::ModelSpec;
+use afmdyn::study::image_ideal::{image as ideal_image, setpoint_study};
 use afmdyn::study::peakforce_image::PeakForceImageStudy;
 use serde::Deserialize;
 

@@ -45,7 +45,8 @@ pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
 pub mod global_continuation;
-pub(crate) mod image;
+pub mod image;
+pub mod image_ideal;
 mod kinds;
 mod memory;
 pub(crate) mod peakforce;

@@ -21,6 +21,7 @@
 
 use super::basins::BasinStudy;
 use super::peakforce_image::{Engage, LinePixel, PeakForceImageStudy};
+use super::scan::{LineJob, ScanStudy};
 use super::stored::sweep_outcome;
 use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
@@ -33,7 +34,7 @@ use crate::error::SimError;
 use crate::request::image::{ImageRequest, SampleMap};
 #[cfg(feature = "files")]
 use crate::request::image_job::ImageKeywords;
-use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
+use crate::request::image_scan::ScanRecipe;
 use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
 use crate::request::{BasinsRequest, BifurcationRequest, DirLock, Resolved};
@@ -534,7 +535,7 @@ impl Plan for Image {
             .map(|t| decode::<(usize, ScanLine)>("result", t))
             .collect::<Result<Vec<_>, _>>()?;
         let img = self.study()?.assemble(lines)?;
-        Ok(crate::request::image_job::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
+        Ok(super::image::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
     }
 }
 
@@ -607,8 +608,7 @@ impl Plan for PfImage {
         let (engages, lines) = self.results(results)?;
         let study = self.study.clone().with_engages(engages);
         let img = study.assemble(lines)?;
-        Ok(crate::request::image_job::ImageOutput::PeakForce(img)
-            .outcome(self.study.request.setpoint))
+        Ok(super::image::ImageOutput::PeakForce(img).outcome(self.study.request.setpoint))
     }
 }
 

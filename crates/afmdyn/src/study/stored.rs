@@ -11,6 +11,8 @@ use super::basins::{basin_store, BasinStudy};
 use super::chart::cells_of;
 use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
+use super::image::ImageOutput;
+use super::scan::ScanStudy;
 use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
 use super::sweep::{sweep_checkpoint, SweepStudy};
@@ -24,8 +26,7 @@ use crate::report::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, S
 use crate::request::chart::Chart;
 use crate::request::checkpoint::CheckpointError;
 use crate::request::checkpoint_file::{each_row, final_csv, final_rows, write_npy};
-use crate::request::image_job::{ImageJob, ImageOutput};
-use crate::request::image_scan::ScanStudy;
+use crate::request::image_job::ImageJob;
 use crate::request::named::{self, Datasets, Outcome};
 use crate::request::run::Bimodal;
 use crate::request::sweep::{every_point_failed, SweepRecord};
