@@ -25,9 +25,9 @@ use serde::{Deserialize, Serialize};
 use super::costs::{image_curves_cost, MODEL_BYTES};
 use super::limits::Cost;
 
+mod ratios;
 mod sample;
-mod study;
-pub use study::{study_ratios, MAX_STUDY_RATIOS};
+pub use ratios::{study_ratios, MAX_STUDY_RATIOS};
 
 pub(crate) use crate::report::image::SetpointStudy;
 pub use crate::report::image::{Image, Material, OperatingPoint, Pixel, Regime};

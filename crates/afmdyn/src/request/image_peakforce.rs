@@ -1,8 +1,8 @@
 //! PeakForce images (issue 61 §3): `afmdyn image --mode peakforce --setpoint 2nN` — the maps
 //! an ideal peak-force feedback records over a sample map ([`super::image::SampleMap`]) with an
 //! off-resonance probe ([`crate::analysis::peakforce`]). This module holds the request's side:
-//! the background probe checked to be off resonance with its setpoint ([`peakforce_probe`]) and
-//! the image's declared cost ([`peakforce_cost`]: the materials' engages and one tap per change
+//! the background probe checked to be off resonance with its setpoint (`peakforce_probe`) and
+//! the image's declared cost (`peakforce_cost`: the materials' engages and one tap per change
 //! of material along the lines); the image runs as a study of lines in the study layer.
 
 use super::costs::{newton_work, steady_periods, MODEL_BYTES};

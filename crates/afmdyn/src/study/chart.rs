@@ -2,7 +2,7 @@
 //! (`Chart::tasks`): its tasks are the tiles of [`ChartPlan`] (cells of one row, continued
 //! along x), its record a tile's cells with the task's number, what a resume skips the stored
 //! tasks ([`super::chart_store`]). Its answer: the `--json` [`document`] with its
-//! [`warnings`](fn@warnings), the CSV rows ([`csv_lines`]) and arrays ([`ChartArrays::layout`])
+//! `warnings`, the CSV rows ([`csv_lines`]) and arrays ([`ChartArrays::layout`])
 //! over the chart's axes, and its presentation (`Chart::view`).
 
 use super::{execute_in_memory, Tasks};
@@ -113,7 +113,7 @@ pub(crate) fn axis(name: &str) -> ChartAxis<'_> {
     }
 }
 
-/// The rows of `cell` of `chart` as CSV lines of [`CSV_HEADER`], lengths in g₀ or, with a
+/// The rows of `cell` of `chart` as CSV lines of [`CSV_HEADER`](crate::request::chart::CSV_HEADER), lengths in g₀ or, with a
 /// probe, in m (`ChartModel::length_m` of the cell).
 pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
     let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);

@@ -1,7 +1,7 @@
 //! `image` run ([`ImageJob`] as an [`Analysis`]): the request's data (`crate::request::image_job`)
 //! held against the budgets before any work (`Request::cost`: the materials' approach curves,
 //! the pixels' memory and a scan's drive periods), run (the ideal feedback's image and setpoint
-//! study, [`super::scan::pi_image`], [`super::peakforce_image::peakforce_image`]) into an
+//! study, [`super::scan::pi_image`], `super::peakforce_image::peakforce_image`) into an
 //! [`ImageOutput`] and presented (`crate::report::present::image`).
 
 use super::image_ideal::{image, setpoint_study};

@@ -1,6 +1,6 @@
 //! The ideal-feedback image of `image` (issue 46) and its setpoint study, computed from the
 //! request (`crate::request::image`: the sample map, the request, their checks and cost): each
-//! material's approach curve ([`material_curves`]), then the image line by line ([`image`]).
+//! material's approach curve (`material_curves`), then the image line by line ([`image`]).
 //!
 //! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
 //! the setpoint A_sp = r A₀ at every pixel, so a pixel's operating point is a point of its

@@ -34,7 +34,7 @@
 //! does not depend on the thread count or the executor.
 //!
 //! Here: the study (`PeakForceImageStudy::tasks`: one task per line) and its local run
-//! ([`peakforce_image`]); the request's checks and cost are
+//! (`peakforce_image`); the request's checks and cost are
 //! [`crate::request::image_peakforce`]'s.
 
 use super::peakforce::{modulus_scale, setpoint_in_newtons};
