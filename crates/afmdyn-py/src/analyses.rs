@@ -59,7 +59,7 @@ pub fn image<'py>(
 }
 
 /// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:
-/// [`afmdyn::request::image::setpoint_study`]): its outcome as [`crate::door::run`]'s, the
+/// [`afmdyn::study::image_ideal::setpoint_study`]): its outcome as [`crate::door::run`]'s, the
 /// JSON (`ratio`, `domains`) and the layout `setpoint_study`. Arguments as [`image`]'s.
 #[pyfunction]
 #[pyo3(signature = (probe, sample, ratios, curve_points=None))]
@@ -70,8 +70,9 @@ pub fn setpoint_study<'py>(
     ratios: Vec<f64>,
     curve_points: Option<usize>,
 ) -> PyResult<Dict<'py>> {
-    use afmdyn::request::image::{setpoint_study, ImageRequest};
+    use afmdyn::request::image::ImageRequest;
     use afmdyn::request::image_job::ImageKeywords;
+    use afmdyn::study::image_ideal::setpoint_study;
     let keywords = ImageKeywords {
         sample: sample.to_string(),
         ..ImageKeywords::default()

@@ -203,7 +203,7 @@ impl ChartStudy {
     /// The `--json` document of the cells in `tasks`, as JSON text.
     fn document(&self, tasks: Vec<String>) -> PyResult<String> {
         let cells = cells_of(&tasks)?;
-        Ok(afmdyn::request::chart::document(&self.chart, &cells).to_string())
+        Ok(afmdyn::study::chart::document(&self.chart, &cells).to_string())
     }
 
     /// Run every task on this machine (`threads` workers, default all cores), with the
@@ -256,7 +256,7 @@ impl ChartStudy {
         if let Some(e) = afmdyn::study::chart::every_cell_failed(&cells) {
             return Err(sim_error(e));
         }
-        let doc = afmdyn::request::chart::document(&this.chart, &cells).to_string();
+        let doc = afmdyn::study::chart::document(&this.chart, &cells).to_string();
         Ok((
             arrays_dict(py, &this.chart, ChartArrays::new(&this.chart, &cells))?,
             doc,

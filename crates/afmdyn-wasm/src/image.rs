@@ -17,16 +17,17 @@
 //! PeakForce image under an ideal peak-force feedback
 //! ([`afmdyn::request::image_peakforce`], `afmdyn image --mode peakforce`), `setpoint` the
 //! peak force (N); its document with every pixel
-//! ([`afmdyn::request::image_peakforce::PeakForceImage::document`]: maps of height,
+//! ([`afmdyn::study::peakforce_image::PeakForceImage::document`]: maps of height,
 //! modulus_dmt, adhesion, deformation, dissipation, …), its lines computed one after the
 //! other (no threads in wasm32; the image does not depend on the thread count). No
 //! `curve_points`, `setpoint_study` or PI feedback with it.
 
 use afmdyn::probe::Probe;
-use afmdyn::request::image::{image as ideal_image, setpoint_study, study_ratios};
+use afmdyn::request::image::study_ratios;
 use afmdyn::request::image::{ImageRequest, SampleMap};
-use afmdyn::request::image_peakforce::PeakForceImageStudy;
 use afmdyn::request::ModelSpec;
+use afmdyn::study::image_ideal::{image as ideal_image, setpoint_study};
+use afmdyn::study::peakforce_image::PeakForceImageStudy;
 use serde::Deserialize;
 
 /// Most pixels (pixels × lines) of an image in wasm: the document holds a dozen values per

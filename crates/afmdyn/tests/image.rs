@@ -9,9 +9,8 @@ use afmdyn::analysis::approach::approach_retract;
 use afmdyn::probe::Probe;
 use afmdyn::report::{setpoint, CurveUnits};
 use afmdyn::request::curves::{approach_request, CurveRequest};
-use afmdyn::request::image::{
-    image, setpoint_study, study_ratios, ImageRequest, Regime, SampleMap,
-};
+use afmdyn::request::image::{study_ratios, ImageRequest, Regime, SampleMap};
+use afmdyn::study::image_ideal::{image, setpoint_study};
 
 fn repo(path: &str) -> String {
     std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()

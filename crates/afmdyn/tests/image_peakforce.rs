@@ -10,10 +10,11 @@ use afmdyn::analysis::peakforce::SETPOINT_TOL;
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
 use afmdyn::request::image::{ImageRequest, SampleMap};
-use afmdyn::request::image_job::{ImageJob, ImageMode, ImageOutput};
-use afmdyn::request::image_peakforce::PeakForceImage;
+use afmdyn::request::image_job::{ImageJob, ImageMode};
 use afmdyn::request::{PeakForceRequest, Resolved};
+use afmdyn::study::image::ImageOutput;
 use afmdyn::study::peakforce_image::peakforce_image;
+use afmdyn::study::peakforce_image::PeakForceImage;
 
 /// The setpoint (N).
 const SETPOINT: f64 = 2e-9;
@@ -255,7 +256,7 @@ fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
     }
     let out = p.outcome(&results).unwrap();
     let img = image(6, 4, 2);
-    let direct = afmdyn::request::image_job::ImageOutput::PeakForce(img).outcome(SETPOINT);
+    let direct = afmdyn::study::image::ImageOutput::PeakForce(img).outcome(SETPOINT);
     assert_eq!(out.document, direct.document);
 }
 

@@ -190,7 +190,7 @@ fn slow_scan_converges_to_the_ideal_image_and_the_error_grows_with_the_scan_rate
         pixels: 10,
         ..ImageRequest::at(0.7)
     };
-    let ideal_doc = afmdyn::request::image::image(&p, &m, &req)
+    let ideal_doc = afmdyn::study::image_ideal::image(&p, &m, &req)
         .unwrap()
         .document(0.7);
     assert_eq!(row(&ideal_doc, 0, "height", 1e9), ideal);

@@ -12,9 +12,9 @@
 use afmdyn::analysis::chart::ChartPlan;
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
-use afmdyn::request::image::setpoint_study;
 use afmdyn::request::image_job::ImageKeywords;
 use afmdyn::request::{named, ChartArrays, ChartRequest, ModelSpec, Resolved};
+use afmdyn::study::image_ideal::setpoint_study;
 use afmdyn::study::named::Outcome;
 use afmdyn::study::stored;
 use afmdyn::Params;

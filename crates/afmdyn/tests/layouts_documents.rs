@@ -8,9 +8,9 @@
 use afmdyn::analysis::progress::Progress;
 use afmdyn::layout::{Layout, Values};
 use afmdyn::probe::Probe;
-use afmdyn::request::image::setpoint_study;
 use afmdyn::request::image_job::ImageKeywords;
 use afmdyn::request::{named, Resolved};
+use afmdyn::study::image_ideal::setpoint_study;
 use afmdyn::study::named::Outcome;
 use afmdyn::Params;
 use serde_json::{json, Value};

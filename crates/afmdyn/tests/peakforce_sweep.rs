@@ -37,7 +37,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 fn run(
     request: &PeakForceRequest,
     p: Params,
-) -> afmdyn::request::Document<afmdyn::request::peakforce::PeakForceResult> {
+) -> afmdyn::request::Document<afmdyn::study::PeakForceResult> {
     afmdyn::request::run::run(request, &Resolved::plain(p), &Progress::new()).unwrap()
 }
 

@@ -670,7 +670,7 @@ impl Probe {
     }
 
     /// A probe file's TOML text as its table, unresolved (an image reads each domain's sample
-    /// over it, [`crate::request::image::image`]); `origin` names it in errors.
+    /// over it, [`crate::request::image`]); `origin` names it in errors.
     ///
     /// # Errors
     /// [`ProbeError::Syntax`] for invalid TOML (the parser's message on one line).

@@ -88,7 +88,7 @@ pub struct Pixel {
     pub switched: bool,
 }
 
-/// An ideal-feedback image ([`crate::request::image::image`]).
+/// An ideal-feedback image (of a [`crate::request::image::SampleMap`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
     /// Pixel centres x (m).
@@ -586,7 +586,7 @@ impl PeakForceImage {
 
 /// The apparent height and phase of every domain against the setpoint (issue 46's setpoint
 /// study: the contrast inversion of AM-AFM, García & San Paulo 2000): at each ratio a line
-/// engaged on the background ([`crate::request::image::image`]'s rule) crosses onto each domain, whose operating point
+/// engaged on the background (the ideal-feedback image's rule) crosses onto each domain, whose operating point
 /// is the one the regime rule takes there. The materials' approach curves are computed once
 /// for all ratios.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -7,18 +7,22 @@
 //! Model values are not part of these requests: they resolve first, through
 //! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
 
-use super::costs::{census_cost, state_bytes, steady_periods, MODEL_BYTES};
+use super::costs::{
+    census_cost, newton_work, recorded_sample_bytes, state_bytes, steady_periods, MODEL_BYTES,
+};
 use super::limits::*;
 use super::run::{Request, Resolved};
 use super::sweep::SweepRecord;
 use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::continuation::ContinuationSpec;
 use crate::analysis::global_continuation::{
     GlobalContinuationSpec, DEFAULT_MATCH_TOL, MAX_CONTINUATION_VALUES,
 };
 use crate::analysis::lyapunov::LyapunovOptions;
 use crate::analysis::observables::Observables;
 use crate::analysis::period::MAX_PERIOD;
+use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
 use crate::error::SimError;
 use crate::integrate::{IntegratorKind, IntegratorOptions};
@@ -26,6 +30,7 @@ use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
 
 mod start;
 pub use start::{initial_state, IntegratorRequest, StartRequest, SteadyRequest};
@@ -608,3 +613,200 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 
 #[cfg(test)]
 mod tests;
+
+impl Request for OrbitRequest {
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        OrbitRequest::validate(self)
+    }
+    fn name(&self) -> &'static str {
+        "orbit"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the steady state from rest (without an initial state), then Newton on the period
+        // asked for or the largest one searched
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, p)?;
+        let period = self.period.unwrap_or(steady.max_period);
+        Ok(Cost {
+            bytes: MODEL_BYTES,
+            work: search + newton_work(p, period, &ShootingOptions::default()),
+        })
+    }
+}
+
+impl Request for ContinuationRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        ContinuationRequest::validate(self, &model.params)
+    }
+    fn name(&self) -> &'static str {
+        "continuation"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the start's steady state, then up to max_points Newton solves per branch (the
+        // cascade: branches of periods n, 2n, 4n, 8n with switching), each point's state and
+        // monodromy kept
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, &p.with(self.param, self.from))?;
+        let n = self.period.unwrap_or(steady.max_period);
+        let points = ContinuationSpec::new(*p, self.param, self.from, self.to, n).max_points;
+        let (branches, top) = match self.switch {
+            true => (4.0, CASCADE_FACTOR * n),
+            false => (1.0, n),
+        };
+        let point = (p.state_dim() * (p.state_dim() + 4)) as f64 * 8.0;
+        Ok(Cost {
+            bytes: MODEL_BYTES + branches * points as f64 * point,
+            work: search
+                + branches * points as f64 * newton_work(p, top, &ShootingOptions::default()),
+        })
+    }
+}
+
+impl Request for LyapunovRequest {
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        LyapunovRequest::validate(self)
+    }
+    fn name(&self) -> &'static str {
+        "lyapunov"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the transient and the averaged periods of the state and its tangent space (one
+        // column per state dimension); one value per block and exponent kept
+        let p = &model.params;
+        let transient = match self.transient {
+            Some(t) => t as f64,
+            None => steady_periods(&SteadyOptions::default(), p)?,
+        };
+        let dim = p.state_dim() as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + self.blocks as f64 * state_bytes(p),
+            work: (transient + self.periods as f64) * (dim + 1.0) * p.modes as f64,
+        })
+    }
+}
+
+impl Request for AttractorsRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "attractors"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        let spec = self.spec(&model.params)?;
+        census_cost(&spec, 1)
+    }
+}
+
+impl Request for ObserveRequest {
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        ObserveRequest::validate(self)
+    }
+    fn name(&self) -> &'static str {
+        "observe"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the start's steady state, Newton on its period (at most the largest searched), then
+        // `periods` of that period; the harmonics' amplitudes and phases kept
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, p)?;
+        let n = steady.max_period;
+        let newton = ShootingOptions {
+            tol: 1e-12,
+            ..ShootingOptions::default()
+        };
+        Ok(Cost {
+            bytes: MODEL_BYTES + self.harmonics as f64 * 32.0,
+            work: search + newton_work(p, n, &newton) + (self.periods * n) as f64 * p.modes as f64,
+        })
+    }
+}
+
+impl Request for ConvergeRequest {
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        ConvergeRequest::validate(self)
+    }
+    fn name(&self) -> &'static str {
+        "converge"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        converge_cost(self, &model.params)
+    }
+}
+
+/// The mode-periods of the steady-state search of a start on `params` (none when it gives its
+/// initial state), and the search's options.
+///
+/// # Errors
+/// As [`super::SteadyRequest::options`]; [`SimError::Params`] when the model cannot be built.
+pub(crate) fn start_work(
+    start: &StartRequest,
+    params: &Params,
+) -> Result<(f64, SteadyOptions), SimError> {
+    let steady = start.steady.options()?;
+    let search = match start.initial {
+        Some(_) => 0.0,
+        None => steady_periods(&steady, params)? * params.modes as f64,
+    };
+    Ok((search, steady))
+}
+
+/// The cost of `converge` on `params`: for N = 1..=`max_modes`, the steady state (the default
+/// search, its cap at `max_modes` modes) and `periods` sampled; every run's samples kept (τ,
+/// W_tip and V_T: 24 bytes a sample) and the last run's trajectory recorded whole
+/// ([`recorded_sample_bytes`]) while they are taken from it.
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub(crate) fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Cost, SimError> {
+    let top = Params {
+        modes: req.max_modes,
+        ..*params
+    };
+    let cap = steady_periods(&SteadyOptions::default(), &top)?;
+    // Σ N over N = 1..=max_modes
+    let modes = (req.max_modes * (req.max_modes + 1) / 2) as f64;
+    let run = req.periods as f64 * req.samples_per_period as f64;
+    Ok(Cost {
+        bytes: MODEL_BYTES + req.max_modes as f64 * run * 24.0 + run * recorded_sample_bytes(&top),
+        work: modes * (cap + req.periods as f64),
+    })
+}
+
+/// The fingerprint of a sweep: everything that determines its rows (the library's version,
+/// the resolved parameters, the swept parameter and its values, every sweep option); a sweep
+/// is resumed only with the same fingerprint. The worker threads are not part of it.
+///
+/// The values are `from`, `to`, `steps`, or `values` when the request lists them.
+pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
+    let mut doc = json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        // how the sweep is cut into tasks and its starts keyed (issue 29): a store written by
+        // the two sequential chains of before is not resumed with segments
+        "plan": super::sweep::PLAN,
+        "params": spec.base,
+        "param": spec.param.name(),
+        "continuation": spec.continuation,
+        "starts": spec.starts,
+        "seed": spec.seed,
+        "tol": spec.steady.tol,
+        "max_periods": spec.steady.max_periods,
+        "max_period": spec.steady.max_period,
+        "integrator": spec.integrator.kind,
+        "steps_per_period": spec.integrator.steps_per_period,
+        "tolerance": spec.integrator.tolerance,
+    });
+    if let Some(map) = doc.as_object_mut() {
+        match &request.values {
+            Some(v) => {
+                map.insert("values".into(), json!(v));
+            }
+            None => {
+                map.insert("from".into(), json!(request.from));
+                map.insert("to".into(), json!(request.to));
+                map.insert("steps".into(), json!(request.steps));
+            }
+        }
+    }
+    doc
+}

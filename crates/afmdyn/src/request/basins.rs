@@ -1,9 +1,12 @@
 //! `basins`: the request of a basin map ([`crate::analysis::basins`]) that the command line
 //! and Python share — its options with their limits and the worker threads (its document and
-//! arrays, [`BasinArrays`], are `crate::report::basins`'s). It runs as a study
-//! (`crate::study::basins`, which holds its `Analysis`).
+//! arrays, [`BasinArrays`], are `crate::report::basins`'s), its checks ([`BasinsRequest::spec`])
+//! and its declared cost. It runs as a study of rows, pass by pass, in the study layer.
 
 use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
+use super::costs::basins_cost;
+use super::limits::Cost;
+use super::run::{Request, Resolved};
 use crate::analysis::basins::{
     BasinSpec, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER,
     DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
@@ -162,5 +165,17 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
             value,
         },
         e => e,
+    }
+}
+
+impl Request for BasinsRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "basins"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        basins_cost(&self.spec(&model.params)?)
     }
 }

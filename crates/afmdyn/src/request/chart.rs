@@ -8,21 +8,21 @@
 //! [`crate::analysis::chart`]'s; this module holds the request, its limits, its fingerprint
 //! (what a resumed chart must match); the one layout of its results is
 //! `crate::report::chart_layout`'s ([`ChartArrays`], the variables of `chart.nc` and of
-//! Python's `xarray.Dataset`; [`CSV_HEADER`], the rows of `chart.csv`), read here through the
-//! chart's axes and length unit.
+//! Python's `xarray.Dataset`; [`CSV_HEADER`], the rows of `chart.csv`), read through the
+//! chart's axes and length unit where the chart runs.
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
+use super::limits::Cost;
 use super::model::{parameter, ModelSpec, ValueKind};
+use super::run::{Request, Resolved};
 use crate::analysis::bifurcation::SweepSpec;
-use crate::analysis::chart::{CellParams, ChartCell, ChartSpec};
+use crate::analysis::chart::{CellParams, ChartSpec};
 use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-use crate::layout::Layout;
-use crate::report::chart_layout::ChartAxis;
 pub use crate::report::chart_layout::{ChartArrays, CSV_HEADER};
 
 /// Largest number of cells of a chart (x_steps × y_steps).
@@ -479,154 +479,24 @@ pub fn axis_unit(name: &str) -> &'static str {
     probe_axis(name).map_or_else(|| parameter(name).map_or("1", |p| p.unit), |a| a.3)
 }
 
-/// The axis `name` as the chart's files show it: its symbol in [`super::MODEL_PARAMETERS`]
-/// and its unit ([`axis_unit`]).
-pub(crate) fn axis(name: &str) -> ChartAxis<'_> {
-    let symbol = parameter(name).map_or(name, |p| p.symbol);
-    ChartAxis {
-        name,
-        symbol,
-        unit: axis_unit(name),
-    }
-}
-
-/// The rows of `cell` of `chart` as CSV lines of [`CSV_HEADER`], lengths in g₀ or, with a
-/// probe, in m (`ChartModel::length_m` of the cell).
-pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
-    let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
-    crate::report::chart_layout::csv_lines(length, cell)
-}
-
-impl ChartArrays {
-    /// The chart's layout over its axes named `x_name` and `y_name`: coordinates `x` and `y`
-    /// in their axes' units, per cell (y, x) `attractors`, `failures`, `dominant_period`, and
-    /// per attractor slot (y, x, attractor) `period`, `motion`, `lyapunov`, `lyapunov_error`,
-    /// `x_max`, `v_t_min`, `contacts_per_period`, `contact_fraction`, `fraction`.
-    pub fn layout(&self, x_name: &str, y_name: &str) -> Layout {
-        self.layout_over(axis(x_name), axis(y_name))
-    }
-
-    /// The arrays of `cells` (any order; each cell once) of the whole chart.
-    pub fn new(chart: &Chart, cells: &[ChartCell]) -> ChartArrays {
-        let size = (chart.spec.x.len(), chart.spec.y.len());
-        ChartArrays::region(chart, (0, 0), size, cells)
-    }
-
-    /// The arrays of the region of `size` = (columns, rows) from the cell `origin` = (ix, iy)
-    /// of the chart: a task's tile is the region ((lo, iy), (hi − lo, 1)); cells outside it are
-    /// left out.
-    pub fn region(
-        chart: &Chart,
-        origin: (usize, usize),
-        size: (usize, usize),
-        cells: &[ChartCell],
-    ) -> ChartArrays {
-        ChartArrays::region_of((&chart.spec, chart.slots), origin, size, cells)
-    }
-}
-
-impl Chart {
-    /// The chart as its presentation reads it ([`crate::report::present::maps::ChartView`]).
-    pub(crate) fn view(&self) -> crate::report::present::maps::ChartView<'_> {
-        crate::report::present::maps::ChartView {
-            spec: &self.spec,
-            slots: self.slots,
-            axes: (axis(self.model.x), axis(self.model.y)),
-            length: Box::new(|x, y| self.model.length_m(x, y).unwrap_or(1.0)),
-        }
-    }
-}
-
-/// The caveats of a chart's answer (the `warnings` of its document): attractors that did not
-/// settle within the transient cap, runs that failed.
-pub(crate) fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
-    let mut w = Vec::new();
-    use crate::analysis::chart::MotionKind;
-    let settling = |c: &&ChartCell| {
-        c.attractors.iter().any(|a| {
-            matches!(
-                a.motion(),
-                MotionKind::Unsettled | MotionKind::Quasiperiodic
-            )
-        })
-    };
-    let unsettled: Vec<&ChartCell> = cells.iter().filter(settling).collect();
-    if let Some(first) = unsettled.first() {
-        w.push(format!(
-            "{} of {} cells have a nonperiodic motion with λ₁ ≤ 0 (first at x = {}, y = {}): \
-             quasi-periodic, or still settling after the transient cap ({}); raise \
-             max_periods to tell (a cantilever of quality factor Q settles over ~Q periods)",
-            unsettled.len(),
-            cells.len(),
-            first.x,
-            first.y,
-            match chart.spec.steady.max_periods {
-                Some(m) => format!("max_periods = {m}"),
-                None => "derived from each cell's decay rate".to_string(),
-            },
-        ));
-    }
-    let failed: u64 = cells.iter().map(|c| u64::from(c.failures)).sum();
-    if failed > 0 {
-        let first = cells
-            .iter()
-            .find_map(|c| c.message.as_deref())
-            .unwrap_or("");
-        w.push(format!(
-            "{failed} runs failed in {} of {} cells; the first: {first}",
-            cells.iter().filter(|c| c.failures > 0).count(),
-            cells.len()
-        ));
-    }
-    w
-}
-
-/// The `--json` document of a chart: the parameters of its first cell (x₀, y₀; the other cells
-/// differ in the two axes), axes with names, units and values; every cell with its attractors;
-/// the counts; with a probe the `si` block of the first cell.
-pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
-    let axis = |name: &str, values: &[f64]| json!({"name": name, "unit": axis_unit(name), "values": values});
-    let cells_json: Vec<Value> = cells
-        .iter()
-        .map(|c| {
-            json!({
-                "ix": c.ix,
-                "iy": c.iy,
-                "attractors": c.attractors.iter().map(|a| json!({
-                    "period": a.period,
-                    "motion": a.motion().name(),
-                    "lyapunov": a.lyapunov,
-                    "lyapunov_error": a.lyapunov_error,
-                    "x_max": a.x_max,
-                    "v_t_min": a.v_t_min,
-                    "contacts_per_period": a.contacts_per_period,
-                    "contact_fraction": a.contact_fraction,
-                    "fraction": a.fraction,
-                    "origin": a.origin,
-                })).collect::<Vec<_>>(),
-                "failures": c.failures,
-                "message": c.message,
-            })
-        })
-        .collect();
-    let first = chart.model.params(chart.spec.x[0], chart.spec.y[0]);
-    let doc = json!({
-        "params": first.as_ref().ok(),
-        "x": axis(chart.model.x, &chart.spec.x),
-        "y": axis(chart.model.y, &chart.spec.y),
-        "units": {"x_max": "g0", "v_t_min": "g0", "lyapunov": "1/τ"},
-        "starts": chart.spec.starts,
-        "cells": cells_json,
-        "failures": cells.iter().map(|c| c.failures as u64).sum::<u64>(),
-        "warnings": warnings(chart, cells),
-    });
-    match &first {
-        Ok(p) => crate::report::with_si(doc, chart.model.probe.as_ref(), p),
-        Err(_) => doc,
-    }
-}
-
 /// The cost of a chart ([`super::costs::chart_cost`] of its spec, slots and cells; its errors).
 pub(crate) fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError> {
     super::costs::chart_cost(&chart.spec, chart.slots, &|x, y| chart.model.params(x, y))
+}
+
+/// A validated chart runs as an analysis ([`crate::request::run()`], Python's `afmdyn.chart`):
+/// its model is its own — [`ChartRequest::chart`](crate::request::ChartRequest::chart) built
+/// it from the request's model values, defaults and probe, validated every option and held
+/// its cost to the budgets — so the `model` given here is not read (pass
+/// [`Resolved::plain`] of any parameters). Its study runs in memory on its threads.
+impl Request for Chart {
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        Ok(())
+    }
+    fn name(&self) -> &'static str {
+        "chart"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        chart_cost(self)
+    }
 }

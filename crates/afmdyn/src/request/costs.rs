@@ -11,7 +11,6 @@
 //! period n its [`crate::analysis::shooting::ShootingOptions::max_iter`] iterations of n
 //! periods of the state and its 2N-column variational system, `(2N + 1) n`.
 
-use super::analyses::{ConvergeRequest, StartRequest};
 use super::limits::{Cost, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
 use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::basins::BasinSpec;
@@ -38,23 +37,6 @@ pub(crate) fn state_bytes(params: &Params) -> f64 {
 /// [`SimError::Params`] when the model cannot be built.
 pub(crate) fn steady_periods(steady: &SteadyOptions, params: &Params) -> Result<f64, SimError> {
     Ok(steady.cap(&CantileverModel::new(params)?) as f64)
-}
-
-/// The mode-periods of the steady-state search of a start on `params` (none when it gives its
-/// initial state), and the search's options.
-///
-/// # Errors
-/// As [`super::SteadyRequest::options`]; [`SimError::Params`] when the model cannot be built.
-pub(crate) fn start_work(
-    start: &StartRequest,
-    params: &Params,
-) -> Result<(f64, SteadyOptions), SimError> {
-    let steady = start.steady.options()?;
-    let search = match start.initial {
-        Some(_) => 0.0,
-        None => steady_periods(&steady, params)? * params.modes as f64,
-    };
-    Ok((search, steady))
 }
 
 /// The mode-periods of a Newton solve of an orbit of `period` drive periods on `params`
@@ -135,28 +117,6 @@ pub(crate) fn census_cost(spec: &AttractorSpec, values: usize) -> Result<Cost, S
 /// and new blocks are both live while it is copied).
 pub(crate) fn recorded_sample_bytes(params: &Params) -> f64 {
     2.0 * (std::mem::size_of::<crate::trajectory::Sample>() as f64 + state_bytes(params))
-}
-
-/// The cost of `converge` on `params`: for N = 1..=`max_modes`, the steady state (the default
-/// search, its cap at `max_modes` modes) and `periods` sampled; every run's samples kept (τ,
-/// W_tip and V_T: 24 bytes a sample) and the last run's trajectory recorded whole
-/// ([`recorded_sample_bytes`]) while they are taken from it.
-///
-/// # Errors
-/// [`SimError::Params`] when the model cannot be built.
-pub(crate) fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Cost, SimError> {
-    let top = Params {
-        modes: req.max_modes,
-        ..*params
-    };
-    let cap = steady_periods(&SteadyOptions::default(), &top)?;
-    // Σ N over N = 1..=max_modes
-    let modes = (req.max_modes * (req.max_modes + 1) / 2) as f64;
-    let run = req.periods as f64 * req.samples_per_period as f64;
-    Ok(Cost {
-        bytes: MODEL_BYTES + req.max_modes as f64 * run * 24.0 + run * recorded_sample_bytes(&top),
-        work: modes * (cap + req.periods as f64),
-    })
 }
 
 /// What the traces of a curve take at their peak for the bytes of their samples
@@ -288,8 +248,6 @@ pub(crate) fn image_curves_cost(
 mod tests {
     use crate::error::SimError;
     use crate::params::Params;
-    use crate::request::image::{image, ImageRequest, SampleMap};
-    use crate::request::image_scan::{PiScan, ScanStudy};
     use crate::request::{ChartRequest, ModelSpec};
 
     fn refused_as(e: SimError, what: &str) {
@@ -318,43 +276,5 @@ mod tests {
         assert!(ChartRequest::default()
             .chart(ModelSpec::default(), Params::default(), None)
             .is_ok());
-    }
-
-    /// An image whose pixels fit the pixel check but not with its approach curves' memory is
-    /// refused before the first curve, ideal and PI alike, naming the image.
-    #[test]
-    fn an_image_beyond_the_budget_is_refused_before_any_work() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../examples/probe-point-mass-dmt.toml"
-        );
-        let table: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
-        let map = SampleMap {
-            size: (1e-6, 1e-6),
-            domains: vec![],
-            height_map: vec![],
-        };
-        // 1100 × 1072 pixels: 1.1792e9 B, within the pixels' own check (1.1 GiB)
-        let req = ImageRequest {
-            pixels: 1100,
-            lines: Some(1072),
-            ..ImageRequest::at(0.8)
-        };
-        req.validate(&map).unwrap();
-        let started = std::time::Instant::now();
-        refused_as(image(&table, &map, &req).unwrap_err(), "image");
-        // the fastest scan: a drive period per pixel
-        let probe = crate::probe::Probe::from_table(&table, "probe").unwrap();
-        let scan = PiScan {
-            scan_rate: Some(probe.drive_frequency / 2200.0),
-            gains: None,
-            time_constant: None,
-        };
-        match ScanStudy::new(&table, &map, &req, &scan) {
-            Err(e) => refused_as(e, "image"),
-            Ok(_) => panic!("a scan beyond the budget was accepted"),
-        }
-        // no curve ran: a curve of 120 points takes far longer in a debug build
-        assert!(started.elapsed().as_secs_f64() < 5.0);
     }
 }

@@ -1,6 +1,7 @@
 //! AM-AFM images of a heterogeneous sample (issue 46): a sample map ([`SampleMap`], the
-//! `--sample S.toml` of `afmdyn image`) and the image an **ideal** amplitude feedback records
-//! over it ([`image`]).
+//! `--sample S.toml` of `afmdyn image`) and the request of the image an **ideal** amplitude
+//! feedback records over it ([`ImageRequest`]: its grid, checks and declared cost); the image
+//! itself is computed in the study layer.
 //!
 //! **Sample map.** `size = [Lx, Ly]` (m; Ly = 0 for a line), then `[[domain]]` entries with a
 //! `name`, `x = [x0, x1]` (m), optional `y = [y0, y1]` (m; the whole width when left out), an
@@ -14,44 +15,21 @@
 //! height map, e.g. from a NumPy array); `height_map = "h.csv"` or `"h.npy"` reads it from a
 //! file (feature `files`: [`crate::io::height_map`]), a relative path taken from the sample
 //! file's directory ([`SampleMap::load`]) or else the current directory ([`SampleMap::parse`]).
-//!
-//! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
-//! the setpoint A_sp = r A₀ at every pixel, so a pixel's operating point is a point of its
-//! material's approach curve where A(z_c) = A_sp ([`crate::analysis::setpoint`]), and the z
-//! piezo records the true height plus the rest distance z_c there. Which of the material's
-//! operating points (in the bistable range one attractive, one repulsive: García & San Paulo,
-//! *Phys. Rev. B* 61 (2000) R13381) is the history's: each line is engaged from far, as an
-//! instrument engages, on the operating point the approach sweep meets first (its largest z_c);
-//! along the line the regime (attractive or repulsive) is kept from pixel to pixel while the new
-//! material has an operating point in it, and otherwise the nearest z_c of the other regime is
-//! taken and the switch reported. The apparent height is h + z_c − z_c,ref, z_c,ref the engaged
-//! rest distance on the background, so a soft domain of the background's true height shows its
-//! difference in z_c (García & San Paulo 2000; the height artefacts of Kühle, Sørensen & Bohr,
-//! *J. Appl. Phys.* 81 (1997) 6562). The operating points of each material are computed once
-//! (an approach curve per material, [`crate::analysis::approach::approach_retract`]), so the
-//! image costs one approach curve per material however many pixels it has, and the
-//! [`setpoint_study`] (every domain's contrast against the setpoint) as many however many
-//! setpoints.
 
-use crate::analysis::approach::approach_retract;
-use crate::analysis::setpoint::operating_points;
-use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
-use super::costs::{check_cost, image_curves_cost, MODEL_BYTES};
-use super::curves::{approach_request, CurveRequest};
+use super::costs::{image_curves_cost, MODEL_BYTES};
 use super::limits::Cost;
 
+mod ratios;
 mod sample;
-mod study;
-pub use study::{setpoint_study, study_ratios, MAX_STUDY_RATIOS};
+pub use ratios::{study_ratios, MAX_STUDY_RATIOS};
 
-pub(crate) use crate::report::image::{DomainContrast, SetpointStudy};
+pub(crate) use crate::report::image::SetpointStudy;
 pub use crate::report::image::{Image, Material, OperatingPoint, Pixel, Regime};
 
 pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
@@ -249,36 +227,6 @@ pub(crate) const IMAGE_BYTES_PER_PIXEL: f64 = 1000.0;
 /// 2048 × 2048 (which aborted on allocation) is refused naming the budget.
 pub(crate) const MAX_IMAGE_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
 
-/// One material's approach curve: the background or a domain's sample under the probe's lever
-/// and drive.
-pub(crate) struct MaterialCurve {
-    pub(crate) name: String,
-    pub(crate) params: Params,
-    pub(crate) curve: crate::analysis::stepped::SteppedCurve,
-    /// The curve's spec (its operating points are refined with it).
-    pub(crate) spec: SteppedSpec,
-    /// Its probe's own warnings ([`Probe::warnings`]: a sample outside its law's regime, a
-    /// value outside its typical range), named by the material.
-    pub(crate) probe_warnings: Vec<String>,
-}
-
-/// The approach curve of `params` (`curve_points` z_c values each way over the probe's default
-/// range, no branches), and its spec.
-fn approach_curve(
-    params: Params,
-    units: &CurveUnits,
-    curve_points: usize,
-) -> Result<(SteppedSpec, crate::analysis::stepped::SteppedCurve), SimError> {
-    let curve_req = CurveRequest {
-        points: Some(curve_points),
-        branches: false,
-        ..CurveRequest::default()
-    };
-    let spec = approach_request(params, &curve_req, units.length, false)?;
-    let curve = approach_retract(&spec)?;
-    Ok((spec, curve))
-}
-
 /// The background probe of an image under the probe file's table `probe_table`.
 ///
 /// # Errors
@@ -316,40 +264,6 @@ pub(crate) fn curves_cost(
         bytes: MODEL_BYTES + curves.bytes + extra.bytes,
         work: curves.work + extra.work * background.params.modes as f64,
     })
-}
-
-/// The materials of `map` under the probe `probe_table`: the background, then one per domain
-/// with its own sample, each with its approach curve; the material of each domain; the SI
-/// units.
-///
-/// `extra` is what the caller adds to the curves' cost (the pixels' memory, a scan's drive
-/// periods): the whole is held against the budgets of a request ([`check_cost`], named
-/// `image`) before the first curve.
-pub(crate) fn material_curves(
-    probe_table: &toml::Table,
-    map: &SampleMap,
-    curve_points: usize,
-    extra: Cost,
-) -> Result<(Vec<MaterialCurve>, Vec<usize>, CurveUnits), SimError> {
-    let background = background_probe(probe_table)?;
-    let units = CurveUnits::from_scales(&background.scales, false);
-    check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
-    let (models, of_domain, warnings) = material_models(probe_table, map, &background)?;
-    let materials = models
-        .into_iter()
-        .zip(warnings)
-        .map(|((name, params), probe_warnings)| {
-            let (spec, curve) = approach_curve(params, &units, curve_points)?;
-            Ok(MaterialCurve {
-                name,
-                params,
-                curve,
-                spec,
-                probe_warnings,
-            })
-        })
-        .collect::<Result<Vec<_>, SimError>>()?;
-    Ok((materials, of_domain, units))
 }
 
 /// The materials' (name, model) of a sample map, the material of each of its domains, and each
@@ -390,101 +304,6 @@ pub(crate) fn material_models(
     Ok((models, of_domain, warnings))
 }
 
-/// The warnings of the materials' approach curves, each named by its material.
-fn curve_warnings(curves: &[MaterialCurve]) -> Vec<String> {
-    curves
-        .iter()
-        .flat_map(|m| {
-            m.curve
-                .warnings
-                .iter()
-                .map(move |w| format!("{} (its approach curve): {w}", m.name))
-        })
-        .collect()
-}
-
-/// The operating points of a material's curve at the setpoint `ratio`, in SI (`units`;
-/// [`crate::report::setpoint`]).
-fn points_at(
-    m: &MaterialCurve,
-    ratio: f64,
-    units: &CurveUnits,
-) -> Result<Vec<OperatingPoint>, SimError> {
-    let (points, dropped) = operating_points(&m.spec, &m.curve, ratio)?;
-    let doc = crate::report::setpoint(&m.params, &m.curve, (&points, &dropped), ratio, units);
-    let num = |p: &Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
-    Ok(doc["points"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .map(|p| OperatingPoint {
-                    source: p["source"].as_str().unwrap_or("").to_string(),
-                    z_c: num(p, "z_c"),
-                    regime: if p["regime"] == "attractive" {
-                        Regime::Attractive
-                    } else {
-                        Regime::Repulsive
-                    },
-                    amplitude: num(p, "amplitude"),
-                    phase_deg: num(p, "phase_deg"),
-                    energy_dissipated: num(p, "energy_dissipated"),
-                    virial: num(p, "virial"),
-                    peak_force: num(p, "peak_force"),
-                    indentation: num(p, "indentation"),
-                })
-                .collect()
-        })
-        .unwrap_or_default())
-}
-
-/// The operating point a line engages on: the approach sweep's first (largest z_c), else the
-/// largest z_c of any.
-fn engage(points: &[OperatingPoint]) -> Option<usize> {
-    let best = |approach_only: bool| {
-        (0..points.len())
-            .filter(|&i| !approach_only || points[i].source == "approach")
-            .max_by(|&a, &b| points[a].z_c.total_cmp(&points[b].z_c))
-    };
-    best(true).or_else(|| best(false))
-}
-
-/// The operating point of a material continued from the previous pixel's (regime, z_c): the
-/// same regime, nearest z_c; else the nearest z_c of the other regime (switched = true).
-fn continue_from(points: &[OperatingPoint], regime: Regime, z_c: f64) -> Option<(usize, bool)> {
-    let nearest = |same: bool| {
-        (0..points.len())
-            .filter(|&i| (points[i].regime == regime) == same)
-            .min_by(|&a, &b| {
-                (points[a].z_c - z_c)
-                    .abs()
-                    .total_cmp(&(points[b].z_c - z_c).abs())
-            })
-    };
-    nearest(true)
-        .map(|i| (i, false))
-        .or_else(|| nearest(false).map(|i| (i, true)))
-}
-
-/// The ideal-feedback image of `map` under `probe` (module docs): the operating points of each
-/// material, then the scan line by line.
-///
-/// # Errors
-/// As [`ImageRequest::validate`]; [`SimError::Probe`] for a domain's sample the probe format
-/// refuses (named by the domain); as the approach curves.
-pub fn image(
-    probe_table: &toml::Table,
-    map: &SampleMap,
-    req: &ImageRequest,
-) -> Result<Image, SimError> {
-    req.validate(map)?;
-    let extra = Cost {
-        bytes: req.pixel_bytes(map),
-        work: 0.0,
-    };
-    let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points, extra)?;
-    image_of(&curves, &of_domain, &units, map, req)
-}
-
 /// The pixel centres x (m, `[pixels]`) and line positions y (m, `[lines]`) of `req` over `map`:
 /// the centres of equal cells of the map's size.
 pub(crate) fn pixel_grid(map: &SampleMap, req: &ImageRequest) -> (Vec<f64>, Vec<f64>) {
@@ -497,90 +316,4 @@ pub(crate) fn pixel_grid(map: &SampleMap, req: &ImageRequest) -> (Vec<f64>, Vec<
         .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
         .collect();
     (x, y)
-}
-
-/// [`image`] from the materials' curves ([`material_curves`]).
-pub(crate) fn image_of(
-    curves: &[MaterialCurve],
-    of_domain: &[usize],
-    units: &CurveUnits,
-    map: &SampleMap,
-    req: &ImageRequest,
-) -> Result<Image, SimError> {
-    let materials: Vec<Material> = curves
-        .iter()
-        .map(|m| {
-            Ok(Material {
-                name: m.name.clone(),
-                points: points_at(m, req.setpoint, units)?,
-                warnings: m.curve.warnings.clone(),
-            })
-        })
-        .collect::<Result<_, SimError>>()?;
-    let (x, y) = pixel_grid(map, req);
-    // the materials' probe warnings (issue 77: the AM image lacked them), then their approach
-    // curves' own (an unsettled point, a failed one), named by material
-    let mut warnings: Vec<String> = curves
-        .iter()
-        .flat_map(|m| m.probe_warnings.clone())
-        .collect();
-    warnings.extend(curve_warnings(curves));
-    for m in &materials {
-        if m.points.is_empty() {
-            warnings.push(format!(
-                "{}: the setpoint A/A0 = {} is not reached on its approach curve: its pixels \
-                 are empty (NaN)",
-                m.name, req.setpoint
-            ));
-        }
-    }
-    let reference = engage(&materials[0].points)
-        .map(|i| materials[0].points[i].z_c)
-        .unwrap_or(f64::NAN);
-    let mut pixels = Vec::with_capacity(y.len());
-    let mut switches = 0usize;
-    for &yj in &y {
-        let mut line = Vec::with_capacity(req.pixels);
-        let mut prev: Option<(Regime, f64)> = None;
-        for &xi in &x {
-            let d = map.domain_at(xi, yj);
-            let material = d.map_or(0, |k| of_domain[k]);
-            let height = map.height_at(xi, yj);
-            let pts = &materials[material].points;
-            let (point, switched) = match prev {
-                None => (engage(pts), false),
-                Some((regime, z)) => match continue_from(pts, regime, z) {
-                    Some((i, s)) => (Some(i), s),
-                    None => (None, false),
-                },
-            };
-            if let Some(i) = point {
-                prev = Some((pts[i].regime, pts[i].z_c));
-            }
-            switches += usize::from(switched);
-            line.push(Pixel {
-                domain: d,
-                material,
-                height,
-                point,
-                switched,
-            });
-        }
-        pixels.push(line);
-    }
-    if switches > 0 {
-        warnings.push(format!(
-            "{switches} pixel(s) switch regime (attractive ↔ repulsive) where a material has no \
-             operating point in the previous one's: the image's contrast changes there"
-        ));
-    }
-    Ok(Image {
-        x,
-        y,
-        materials,
-        pixels,
-        reference,
-        domain_names: map.domains.iter().map(|d| d.name.clone()).collect(),
-        warnings,
-    })
 }

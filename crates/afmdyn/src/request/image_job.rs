@@ -1,18 +1,18 @@
 //! `image` as data ([`ImageJob`]): the probe file's table, the sample map, the request, the
-//! feedback (ideal, or a PI scan with its settings) and the setpoint study; its run as an
-//! [`super::run::Analysis`] (cost, execution, document and presentation) is the study layer's
-//! (`crate::study::image`), and so is its PI scan's run resumably into a store
-//! (`crate::study::stored::Resumable`, its study `ImageJob::scan_study`).
+//! feedback (ideal, or a PI scan with its settings) and the setpoint study, with its checks
+//! and declared cost ([`super::run::Request`]); its run (execution, document and presentation,
+//! and a PI scan's run resumably into a store) is the study layer's.
 
-use super::image::{background_probe, Image, ImageRequest, SampleMap, SetpointStudy};
+use super::image::{background_probe, curves_cost, ImageRequest, SampleMap};
 use super::image_options::GivenOptions;
-use super::image_peakforce::PeakForceImage;
-use super::image_scan::{PiImage, PiScan};
+use super::image_peakforce::{peakforce_cost, peakforce_probe};
+use super::image_scan::resolve;
+use super::image_scan::PiScan;
 #[cfg(feature = "files")]
-use super::image_scan::{ScanRecipe, ScanStudy};
-use super::run::Resolved;
+use super::image_scan::ScanRecipe;
+use super::limits::{check_threads, Cost};
+use super::run::{Request, Resolved};
 use crate::error::SimError;
-use crate::study::named::Outcome;
 use serde::{Deserialize, Serialize};
 
 pub use super::image_options::ImageMode;
@@ -37,24 +37,6 @@ pub struct ImageJob {
     pub threads: Option<usize>,
 }
 
-/// An [`ImageJob`]'s result.
-// one value a run, its bulk on the heap: the variants' sizes do not matter
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, PartialEq)]
-pub enum ImageOutput {
-    /// An ideal-feedback image and its setpoint study.
-    Ideal {
-        /// The image.
-        image: Image,
-        /// The setpoint study, when one was asked for.
-        study: Option<SetpointStudy>,
-    },
-    /// A PI-scanned image.
-    Pi(PiImage),
-    /// A PeakForce image (ideal peak-force feedback).
-    PeakForce(PeakForceImage),
-}
-
 impl ImageJob {
     /// The model the job runs on: the background probe's parameters, without the SI block
     /// (the image's documents are in SI already).
@@ -63,19 +45,6 @@ impl ImageJob {
     /// As the background probe's reading: a probe the format refuses, a multifrequency drive.
     pub fn model(&self) -> Result<Resolved, SimError> {
         Ok(Resolved::plain(background_probe(&self.probe)?.params))
-    }
-
-    /// The PI scan's study (its materials' approach curves computed), for a front end that
-    /// runs it into a store of its own; `None` for the ideal feedback.
-    ///
-    /// # Errors
-    /// As [`ScanStudy::new`].
-    #[cfg(feature = "files")]
-    pub(crate) fn scan_study(&self) -> Result<Option<ScanStudy>, SimError> {
-        self.feedback
-            .as_ref()
-            .map(|scan| ScanStudy::new(&self.probe, &self.sample, &self.request, scan))
-            .transpose()
     }
 }
 
@@ -176,36 +145,72 @@ impl ImageKeywords {
     }
 }
 
-impl ImageOutput {
-    /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
-    /// `image.nc`'s variables, `super::image_layout`) and, as the fact `summary`, the
-    /// command line's `image.json` ([`crate::report::present::image`]).
-    pub fn outcome(&self, setpoint: f64) -> Outcome {
-        use crate::report::image_layout::{layout, peakforce_layout, scan_layout};
-        use crate::report::present::image::{ideal_summary, peakforce_summary, pi_summary};
-        let (document, layout, summary) = match self {
-            ImageOutput::Ideal { image, study } => (
-                image.document(setpoint),
-                layout(image, setpoint),
-                ideal_summary(image, setpoint, study.as_ref()),
-            ),
-            ImageOutput::Pi(img) => (
-                img.document(setpoint),
-                scan_layout(img, setpoint),
-                pi_summary(img, setpoint),
-            ),
-            ImageOutput::PeakForce(img) => (
-                img.document(),
-                peakforce_layout(img),
-                peakforce_summary(img),
-            ),
-        };
-        let mut facts = serde_json::Map::new();
-        facts.insert("summary".into(), summary);
-        Outcome {
-            document,
-            datasets: vec![("image".into(), layout)],
-            facts,
+impl ImageJob {
+    /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
+    /// setpoint force > 0, no PI feedback and no setpoint study.
+    fn validate_peakforce(&self) -> Result<(), SimError> {
+        if self.feedback.is_some() || self.study.is_some() {
+            return Err(SimError::out_of_range(
+                "mode",
+                "peakforce",
+                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
+                 setpoint study)",
+            ));
         }
+        self.request.validate_grid(&self.sample)?;
+        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
+    }
+}
+
+impl Request for ImageJob {
+    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
+        self.request.validate(&self.sample)?;
+        check_threads(self.threads)?;
+        if self.mode == ImageMode::Peakforce {
+            return self.validate_peakforce();
+        }
+        let background = background_probe(&self.probe)?;
+        background.serves("image --mode am", crate::probe::ProbeNeeds::Tapping)?;
+        match (&self.feedback, &self.study) {
+            (Some(_), Some(_)) => Err(SimError::out_of_range(
+                "setpoint_study",
+                "a study with the PI feedback",
+                "only with the ideal feedback (a study of exact operating points)",
+            )),
+            (Some(scan), None) => {
+                resolve(&background, &self.sample, &self.request, scan).map(|_| ())
+            }
+            (None, _) => Ok(()),
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        "image"
+    }
+
+    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+        if self.mode == ImageMode::Peakforce {
+            return peakforce_cost(&self.probe, &self.sample, &self.request);
+        }
+        let background = background_probe(&self.probe)?;
+        let (map, req) = (&self.sample, &self.request);
+        let periods = match &self.feedback {
+            Some(scan) => resolve(&background, map, req, scan)?.2,
+            None => 0.0,
+        };
+        let extra = Cost {
+            bytes: req.pixel_bytes(map),
+            work: periods,
+        };
+        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
+        if self.study.is_some() {
+            // the study computes the materials' curves once more
+            let none = Cost {
+                bytes: 0.0,
+                work: 0.0,
+            };
+            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
+        }
+        Ok(cost)
     }
 }

@@ -9,8 +9,8 @@
 //!   `attractors`, `orbit`, `continuation`, `lyapunov`, `observe`) with `validate`, and `run`
 //!   where the analysis is one library call.
 //! - [`chart`](mod@chart): the two-parameter behaviour chart ([`ChartRequest`]), its limits,
-//!   fingerprint and result layout (its study and store: [`crate::study::chart`],
-//!   `crate::study::chart_store`).
+//!   fingerprint and cost (it runs as a study of tiles, with its document and store, in the
+//!   study layer).
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).

@@ -2,21 +2,21 @@
 //! tap at a mean rest separation z_c, or at the z_c an ideal peak-force feedback finds for a
 //! setpoint, with the instrument's channels, one cycle and the force–distance curve — the
 //! request the command line (`afmdyn peakforce`) and, by its name, Python and the browser
-//! share, and its document. With a probe everything is SI (m, N, J, s, Pa); without one the
+//! share (its document is made where it runs). With a probe everything is SI (m, N, J, s, Pa); without one the
 //! model's units (g₀, F̃, F̃·g₀, τ).
 
-use super::peakforce_sweep::SweepTap;
-use super::run::Resolved;
+use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
+use super::limits::Cost;
+use super::run::{Request, Resolved};
 use crate::analysis::peakforce::{
-    low_pass_periodic, static_compliance, Cycle, PeakForceOptions, SteadyTap, FIT_BAND,
-    MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
+    PeakForceOptions, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
+    SETPOINT_ITERATIONS,
 };
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
 
 pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_POINTS};
 
@@ -81,22 +81,6 @@ impl Default for PeakForceRequest {
             sweep: None,
         }
     }
-}
-
-/// The result of a `peakforce` request: the tap and the α5 it was computed at.
-#[derive(Debug, Clone)]
-pub struct PeakForceResult {
-    /// α5 of the tap (the request's z_c, or the setpoint's).
-    pub alpha5: f64,
-    /// The steady tap.
-    pub tap: SteadyTap,
-    /// Steady taps the setpoint's feedback computed (1 at a given z_c).
-    pub evaluations: usize,
-    /// The measured force k × deflection (F̃) over the cycle through the instrument's filter
-    /// (with [`PeakForceRequest::filter_cutoff`]).
-    pub filtered: Option<Vec<f64>>,
-    /// Every value's tap of [`PeakForceRequest::sweep`], in its order.
-    pub sweep: Option<Vec<SweepTap>>,
 }
 
 impl PeakForceRequest {
@@ -249,7 +233,7 @@ impl PeakForceRequest {
 impl PeakForceRequest {
     /// The cycle's sampling interval, the modulation period over `samples` (s with a probe,
     /// else τ).
-    fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
+    pub(crate) fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
         std::f64::consts::TAU / p.omega / self.samples as f64 * Self::units(model).time
     }
 
@@ -320,390 +304,48 @@ impl PeakForceRequest {
         }
         Ok(points)
     }
+}
 
-    /// The measured force k × deflection (the deflection over the static compliance) of the
-    /// tap's cycle through the filter of [`PeakForceRequest::filter_cutoff`], F̃.
-    pub(crate) fn filtered(
-        &self,
-        model: &Resolved,
-        p: &Params,
-        tap: &SteadyTap,
-    ) -> Result<Option<Vec<f64>>, SimError> {
-        let Some(fc) = self.filter_cutoff else {
-            return Ok(None);
+impl Request for PeakForceRequest {
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.params(model).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "peakforce"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every tap: the transient (at most its cap) and Newton's variational flows, each drive
+        // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle
+        // and the fit's resampling kept
+        let p = self.params(model)?;
+        let opts = self.options();
+        let tap_work = |q: &Params| -> Result<f64, SimError> {
+            let lever_periods = (1.0 / q.omega).max(1.0);
+            Ok((steady_periods(&opts.steady, q)? * q.modes as f64
+                + newton_work(q, 1, &opts.shooting))
+                * lever_periods)
         };
-        let c = static_compliance(&CantileverModel::new(p)?);
-        let measured: Vec<f64> = tap.cycle.deflection.iter().map(|w| w / c).collect();
-        low_pass_periodic(&measured, fc * self.sampling_interval(model, p)).map(Some)
-    }
-}
-
-/// The filter's words in the document (`filter.kind`).
-pub(crate) const FILTER_KIND: &str =
-    "second-order Butterworth low-pass (Butterworth 1930; bilinear \
-     transform with the cut-off prewarped), causal as the instrument's real-time filter, in \
-     its periodic steady state over the cycle, on the measured force k × deflection: \
-     curve.approach_filtered_force and curve.retract_filtered_force";
-
-/// The sample's true reduced modulus E* (Pa) of a Hertz-type law under a probe: from the
-/// Hertz group α4 = (4/3)E*√R g₀^{3/2}/F_s (module docs of [`crate::probe`]).
-fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
-    let pr = model.probe.as_ref()?;
-    let r = pr.tip_radius?;
-    let s = &pr.scales;
-    Some(alpha4 * s.force_n / (4.0 / 3.0 * r.sqrt() * s.length_m.powf(1.5)))
-}
-
-/// A DMT fit whose root-mean-square residual passes this fraction of the fitted force range
-/// is said not to be the DMT relation's shape.
-pub(crate) const MAX_FIT_RESIDUAL: f64 = 0.1;
-/// A modulus_dmt more than this fraction off the sample's own E* (which a simulation knows) is
-/// said to be biased.
-pub(crate) const MAX_MODULUS_BIAS: f64 = 0.1;
-
-/// Why a single tap's `modulus_dmt` is missing, or where it is not the sample's modulus
-/// (issue 77): no fit (too few retract points in the band), a fit residual above
-/// [`MAX_FIT_RESIDUAL`], a reading more than [`MAX_MODULUS_BIAS`] off the sample's own E*
-/// (Hertz group α4 of `p`). A double tap is said by its own warning.
-fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> {
-    if tap.channels.taps_per_cycle > 1.0 + 1e-9 {
-        return Vec::new();
-    }
-    let Some(fit) = tap.fit else {
-        return vec![format!(
-            "modulus_dmt is missing: the DMT fit needs at least {} retract points between {} and \
-             {} of the force range from the adhesion to the peak force, and this tap's retract \
-             has fewer there (a contact short against the cycle's samples: raise samples, or \
-             widen fit_band)",
-            crate::analysis::peakforce::MIN_FIT_POINTS,
-            band[0],
-            band[1]
-        )];
-    };
-    let mut w = Vec::new();
-    if fit.relative_residual > MAX_FIT_RESIDUAL {
-        w.push(format!(
-            "modulus_dmt: the DMT fit's relative residual is {:.3} (above {MAX_FIT_RESIDUAL}): \
-             the retract curve in the fit band does not have the DMT relation's shape, so the \
-             modulus is not meaningful",
-            fit.relative_residual
-        ));
-    }
-    let ratio = fit.hertz_group / p.alpha4;
-    if (ratio - 1.0).abs() > MAX_MODULUS_BIAS {
-        let law = p.contact_law.name();
-        let other_law = match law {
-            "hertz" | "dmt" => String::new(),
-            _ => format!("a {law} sample read with the DMT relation, "),
-        };
-        w.push(format!(
-            "modulus_dmt reads {ratio:.3} × the sample's own E* (more than {:.0} % off): the DMT \
-             fit of this tap is biased ({other_law}the lever's inertia and ringing within the \
-             tap, an indentation past the paraboloid's validity): compare it against a \
-             calibration sample, not as the sample's modulus",
-            MAX_MODULUS_BIAS * 100.0
-        ));
-    }
-    w
-}
-
-/// The factor from the fitted Hertz group (model units) to the reduced modulus E* (Pa) of the
-/// model `p` under the probe of `model`; `None` for a law without a tip radius (no modulus)
-/// or without a probe (the Hertz group itself is reported).
-pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
-    let has_radius = p.contact_law.info().tip_radius;
-    true_modulus(model, 1.0).filter(|_| has_radius)
-}
-
-/// The document of a steady tap (`afmdyn peakforce --json`, Python's `to_dict()`): `channels`
-/// (the instrument's, SI with a probe), `modulus` (the DMT fit beside the true modulus),
-/// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
-/// (time, deflection, distance, force from the largest separation) and `curve` (the
-/// force–distance curve, approach and retract), `z_c`, `units`, `method`, `warnings`.
-pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
-    let u = PeakForceRequest::units(model);
-    let tap = &r.tap;
-    let c = &tap.channels;
-    // a sweep's single-tap blocks are its first computed value's (its Ω in a sweep of f_m)
-    let p = r
-        .sweep
-        .iter()
-        .flatten()
-        .find(|t| t.tap.is_some())
-        .map_or(model.params, |t| t.params)
-        .with(SweepParam::Alpha5, r.alpha5);
-    let has_radius = p.contact_law.info().tip_radius;
-    // the fitted Hertz group to a modulus (SI with a probe), beside the true one
-    let fitted = tap.fit.map(|f| f.hertz_group);
-    let (modulus_fit, modulus_true) = match true_modulus(model, 1.0) {
-        Some(scale) if has_radius => (fitted.map(|k| k * scale), Some(p.alpha4 * scale)),
-        _ => (fitted, has_radius.then_some(p.alpha4)),
-    };
-    // a sweep's taps are each checked (the sweep's warnings, below); a single tap here
-    let mut warnings: Vec<String> = if r.sweep.is_some() {
-        Vec::new()
-    } else {
-        super::peakforce_sweep::tap_warnings(tap)
-            .into_iter()
-            .map(|(_, w)| w)
-            .collect()
-    };
-    if r.sweep.is_none() && has_radius {
-        warnings.extend(modulus_warnings(tap, request.fit_band, &p));
-    }
-    let t = &tap.cycle;
-    let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
-    let period = std::f64::consts::TAU / p.omega;
-    let omega1 = first_natural_frequency(&p);
-    let sweep = sweep_block(request, model, r, has_radius, &mut warnings);
-    json!({
-        "sweep": sweep,
-        "channels": {
-            "peak_force": c.peak_force * u.force,
-            "adhesion": c.adhesion * u.force,
-            "deformation": c.deformation * u.length,
-            "dissipation": c.dissipation * u.energy,
-            "contact_time": c.contact_time * u.time,
-            "snap_off_time": c.snap_off_time * u.time,
-            "ringing_amplitude": c.ringing_amplitude * u.length,
-            "modulus_dmt": modulus_fit,
-            "taps_per_cycle": c.taps_per_cycle,
-        },
-        "modulus": {
-            "modulus_dmt": modulus_fit,
-            "true": modulus_true,
-            "ratio": match (fitted, has_radius) { (Some(k), true) => Some(k / p.alpha4), _ => None },
-            "tip_sample_modulus": match true_modulus(model, 1.0) {
-                Some(scale) if has_radius => tap.fit_tip_sample.map(|f| f.hertz_group * scale),
-                _ => tap.fit_tip_sample.map(|f| f.hertz_group),
-            },
-            "force_measured_as": "k × deflection (the deflection over the lever's static compliance at the tip), as the instrument does; tip_sample_modulus is the same fit on the true tip–sample force",
-            "fit_band": request.fit_band,
-            "fit_points": tap.fit.map(|f| f.points),
-            "fit_relative_residual": tap.fit.map(|f| f.relative_residual),
-            "contact_distance": tap.fit.map(|f| f.contact_distance * u.length),
-            "quantity": if u.si { "reduced modulus E* (Pa), 1/E* = (1 − ν_t²)/E_t + (1 − ν_s²)/E_s" } else { "Hertz group (4/3)E*√R in model units (α4)" },
-        },
-        "z_c": p.rest_distance() * u.length,
-        "setpoint": request.setpoint,
-        "feedback_evaluations": r.evaluations,
-        "modulation": {
-            "period": period * u.time,
-            "f0_over_fm": omega1 / p.omega,
-            "amplitude": p.alpha2 * u.length,
-        },
-        "orbit": {
-            "period": tap.period,
-            "stable": tap.stable,
-            "multipliers": multipliers,
-            "transient_periods": tap.transient_periods,
-        },
-        "balance": {
-            "modulation_work": tap.balance.modulation_work * u.energy,
-            "lever_damping": tap.balance.lever_damping * u.energy,
-            "tip_sample": tap.balance.tip_sample * u.energy,
-            "base_forcing": tap.balance.base_forcing * u.energy,
-            "residual": tap.balance.residual * u.energy,
-        },
-        "cycle": {
-            "time": scaled(&t.time, u.time),
-            "deflection": scaled(&t.deflection, u.length),
-            "distance": scaled(&t.distance, u.length),
-            "force": scaled(&t.force, u.force),
-        },
-        "curve": curve_block(t, r.filtered.as_deref(), &u),
-        "filter": request.filter_cutoff.map(|fc| json!({
-            "cutoff": fc,
-            "kind": FILTER_KIND,
-        })),
-        "units": units_block(u.si),
-        "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/afm-workflow.md)",
-        "warnings": warnings,
-    })
-}
-
-/// A column of the cycle in the document's units.
-fn scaled(v: &[f64], scale: f64) -> Vec<f64> {
-    v.iter().map(|x| x * scale).collect()
-}
-
-/// The document's `curve`: the cycle's force–distance curve, approach (its first half, from the
-/// largest separation) and retract, with the filtered force when there is one.
-fn curve_block(t: &Cycle, filtered: Option<&[f64]>, u: &CurveUnits) -> Value {
-    let half = t.time.len() / 2;
-    let mut curve = json!({
-        "approach_distance": scaled(&t.distance[..half], u.length),
-        "approach_force": scaled(&t.force[..half], u.force),
-        "retract_distance": scaled(&t.distance[half..], u.length),
-        "retract_force": scaled(&t.force[half..], u.force),
-    });
-    if let Some(fl) = filtered {
-        curve["approach_filtered_force"] = json!(scaled(&fl[..half], u.force));
-        curve["retract_filtered_force"] = json!(scaled(&fl[half..], u.force));
-    }
-    curve
-}
-
-/// The document's `sweep` block (`None` without a sweep), its warnings added to `warnings`.
-fn sweep_block(
-    request: &PeakForceRequest,
-    model: &Resolved,
-    r: &PeakForceResult,
-    has_radius: bool,
-    warnings: &mut Vec<String>,
-) -> Option<Value> {
-    let frame = sweep_frame(model, has_radius);
-    let sweep = request.sweep.as_ref().zip(r.sweep.as_ref());
-    let sweep = sweep.map(|(s, taps)| super::peakforce_sweep::sweep_document(s, &frame, taps));
-    if let (Some(block), Some(taps)) = (&sweep, &r.sweep) {
-        warnings.extend(super::peakforce_sweep::sweep_warnings(block, taps));
-        let failed = block["message"]
-            .as_array()
-            .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
-        if failed > 0 {
-            warnings.push(format!(
-                "{failed} of the sweep's values failed (null in sweep.channels; their \
-                 messages in sweep.message)"
-            ));
-        }
-    }
-    sweep
-}
-
-/// What a sweep's channels are read through: the document's units, and the modulus in Pa (with a
-/// probe, for a law with a tip radius `has_radius`) or as the Hertz group.
-fn sweep_frame(model: &Resolved, has_radius: bool) -> super::peakforce_sweep::Frame {
-    super::peakforce_sweep::Frame {
-        u: PeakForceRequest::units(model),
-        modulus_scale: true_modulus(model, 1.0)
-            .filter(|_| has_radius)
-            .unwrap_or(1.0),
-    }
-}
-
-/// The document's `units`: SI with a probe, else the model's.
-fn units_block(si: bool) -> Value {
-    if si {
-        json!({"peak_force": "N", "adhesion": "N", "deformation": "m", "dissipation": "J", "contact_time": "s",
-                   "snap_off_time": "s (from the largest separation)", "ringing_amplitude": "m", "modulus_dmt": "Pa", "z_c": "m",
-                   "time": "s", "deflection": "m", "distance": "m", "force": "N"})
-    } else {
-        json!({"peak_force": "F", "adhesion": "F", "deformation": "g0", "dissipation": "F·g0", "contact_time": "τ",
-                   "snap_off_time": "τ (from the largest separation)", "ringing_amplitude": "g0", "modulus_dmt": "α4 (Hertz group)", "z_c": "g0",
-                   "time": "τ", "deflection": "g0", "distance": "g0", "force": "F"})
-    }
-}
-
-impl crate::study::named::Datasets for PeakForceRequest {
-    /// `cycle` (time, deflection, distance, force over one period from the largest
-    /// separation) and `curve` (approach and retract, each over its own dimension), in the
-    /// document's units; the channels as facts.
-    fn datasets(
-        &self,
-        model: &Resolved,
-        r: &PeakForceResult,
-    ) -> Result<crate::study::named::Arrays, SimError> {
-        use crate::layout::{Layout, Variable};
-        let doc = document(self, model, r);
-        let units = &doc["units"];
-        let unit = |k: &str| units[k].as_str().unwrap_or("").to_string();
-        let arr = |block: &str, k: &str| -> Vec<f64> {
-            doc[block][k].as_array().map_or(Vec::new(), |a| {
-                a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect()
-            })
-        };
-        let n = r.tap.cycle.time.len();
-        let cycle = Layout::new(
-            "peakforce cycle",
-            &[("sample", n)],
-            ["time", "deflection", "distance", "force"]
+        let tap = match &self.sweep {
+            Some(s) => self
+                .sweep_points(s, model, &p)?
                 .iter()
-                .map(|k| Variable::f64(k, &["sample"], &unit(k), *k, &arr("cycle", k)))
-                .collect(),
-        );
-        let (a, b) = (
-            arr("curve", "approach_distance").len(),
-            arr("curve", "retract_distance").len(),
-        );
-        let mut variables = vec![
-            Variable::f64(
-                "approach_distance",
-                &["approach"],
-                &unit("distance"),
-                "distance, approach",
-                &arr("curve", "approach_distance"),
-            ),
-            Variable::f64(
-                "approach_force",
-                &["approach"],
-                &unit("force"),
-                "force, approach",
-                &arr("curve", "approach_force"),
-            ),
-            Variable::f64(
-                "retract_distance",
-                &["retract"],
-                &unit("distance"),
-                "distance, retract",
-                &arr("curve", "retract_distance"),
-            ),
-            Variable::f64(
-                "retract_force",
-                &["retract"],
-                &unit("force"),
-                "force, retract",
-                &arr("curve", "retract_force"),
-            ),
-        ];
-        // the measured force through the instrument's filter, with filter_cutoff
-        if r.filtered.is_some() {
-            for (k, dim, what) in [
-                (
-                    "approach_filtered_force",
-                    "approach",
-                    "filtered k × deflection, approach",
-                ),
-                (
-                    "retract_filtered_force",
-                    "retract",
-                    "filtered k × deflection, retract",
-                ),
-            ] {
-                variables.push(Variable::f64(
-                    k,
-                    &[dim],
-                    &unit("force"),
-                    what,
-                    &arr("curve", k),
-                ));
-            }
-        }
-        let curve = Layout::new(
-            "peakforce force-distance curve",
-            &[("approach", a), ("retract", b)],
-            variables,
-        );
-        let facts = doc["channels"].as_object().cloned().unwrap_or_default();
-        let mut layouts = vec![("cycle".into(), cycle), ("curve".into(), curve)];
-        if let Some((s, taps)) = self.sweep.as_ref().zip(r.sweep.as_ref()) {
-            // the contact law, and so its tip radius, is the same at every value of a sweep
-            let frame = sweep_frame(model, model.params.contact_law.info().tip_radius);
-            let layout = super::peakforce_sweep::sweep_layout(s, &frame, taps);
-            layouts.push(("sweep".into(), layout));
-        }
-        Ok((layouts, facts))
+                .map(tap_work)
+                .sum::<Result<f64, SimError>>()?,
+            None => tap_work(&p)?,
+        };
+        let per_value = if self.setpoint.is_some() {
+            (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
+        } else {
+            1.0
+        };
+        let taps = per_value;
+        let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
+            work: taps * tap,
+        })
     }
-}
-
-/// A refusal of the setpoint stated in newtons (`newtons`, the request's value): the search
-/// works in F̃, which a user of a probe never wrote (issue 77); other errors unchanged.
-pub(crate) fn setpoint_in_newtons(e: SimError, newtons: f64) -> SimError {
-    match e {
-        SimError::OutOfRange { name, allowed, .. } if name == "setpoint" => SimError::OutOfRange {
-            name,
-            value: format!("{} N", crate::error::number(newtons)),
-            allowed,
-        },
-        e => e,
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        self.params(model)
     }
 }

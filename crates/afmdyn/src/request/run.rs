@@ -20,19 +20,10 @@
 //! counts) and stop with [`SimError::Cancelled`] when it is cancelled. `modes`, `orbit` and
 //! `observe` are one short computation each and neither count nor check it.
 
-use super::analyses::{
-    AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
-    OrbitRequest,
-};
-use super::costs::{census_cost, converge_cost, stepped_cost};
-use super::costs::{check_cost, newton_work, start_work, state_bytes, steady_periods, MODEL_BYTES};
+use super::costs::{check_cost, stepped_cost};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
-use super::limits::CASCADE_FACTOR;
-use crate::analysis::continuation::ContinuationSpec;
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::ShootingOptions;
-use crate::analysis::steady::SteadyOptions;
 use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
@@ -259,126 +250,6 @@ pub fn document<A: Analysis + ?Sized>(
         }
     }
     Ok(doc)
-}
-
-impl Request for OrbitRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        OrbitRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "orbit"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the steady state from rest (without an initial state), then Newton on the period
-        // asked for or the largest one searched
-        let p = &model.params;
-        let (search, steady) = start_work(&self.start, p)?;
-        let period = self.period.unwrap_or(steady.max_period);
-        Ok(Cost {
-            bytes: MODEL_BYTES,
-            work: search + newton_work(p, period, &ShootingOptions::default()),
-        })
-    }
-}
-
-impl Request for ContinuationRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        ContinuationRequest::validate(self, &model.params)
-    }
-    fn name(&self) -> &'static str {
-        "continuation"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the start's steady state, then up to max_points Newton solves per branch (the
-        // cascade: branches of periods n, 2n, 4n, 8n with switching), each point's state and
-        // monodromy kept
-        let p = &model.params;
-        let (search, steady) = start_work(&self.start, &p.with(self.param, self.from))?;
-        let n = self.period.unwrap_or(steady.max_period);
-        let points = ContinuationSpec::new(*p, self.param, self.from, self.to, n).max_points;
-        let (branches, top) = match self.switch {
-            true => (4.0, CASCADE_FACTOR * n),
-            false => (1.0, n),
-        };
-        let point = (p.state_dim() * (p.state_dim() + 4)) as f64 * 8.0;
-        Ok(Cost {
-            bytes: MODEL_BYTES + branches * points as f64 * point,
-            work: search
-                + branches * points as f64 * newton_work(p, top, &ShootingOptions::default()),
-        })
-    }
-}
-
-impl Request for LyapunovRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        LyapunovRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "lyapunov"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the transient and the averaged periods of the state and its tangent space (one
-        // column per state dimension); one value per block and exponent kept
-        let p = &model.params;
-        let transient = match self.transient {
-            Some(t) => t as f64,
-            None => steady_periods(&SteadyOptions::default(), p)?,
-        };
-        let dim = p.state_dim() as f64;
-        Ok(Cost {
-            bytes: MODEL_BYTES + self.blocks as f64 * state_bytes(p),
-            work: (transient + self.periods as f64) * (dim + 1.0) * p.modes as f64,
-        })
-    }
-}
-
-impl Request for AttractorsRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "attractors"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        let spec = self.spec(&model.params)?;
-        census_cost(&spec, 1)
-    }
-}
-
-impl Request for ObserveRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        ObserveRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "observe"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the start's steady state, Newton on its period (at most the largest searched), then
-        // `periods` of that period; the harmonics' amplitudes and phases kept
-        let p = &model.params;
-        let (search, steady) = start_work(&self.start, p)?;
-        let n = steady.max_period;
-        let newton = ShootingOptions {
-            tol: 1e-12,
-            ..ShootingOptions::default()
-        };
-        Ok(Cost {
-            bytes: MODEL_BYTES + self.harmonics as f64 * 32.0,
-            work: search + newton_work(p, n, &newton) + (self.periods * n) as f64 * p.modes as f64,
-        })
-    }
-}
-
-impl Request for ConvergeRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        ConvergeRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "converge"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        converge_cost(self, &model.params)
-    }
 }
 
 /// `approach`: the approach–retract curve over the rest distance z_c with its branches

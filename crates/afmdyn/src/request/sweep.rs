@@ -1,50 +1,12 @@
-//! The fingerprint of a bifurcation request that a resumed sweep must match, and the first
-//! field in which two differ; the sweep's records are `crate::report::sweep`'s (re-exported
-//! here).
+//! What a resumed sweep holds against its store: the plan in a bifurcation request's
+//! fingerprint (`super::analyses::fingerprint`), the first field in which two fingerprints
+//! differ and the number of a sweep's points; the sweep's records are `crate::report::sweep`'s
+//! (re-exported here).
 
 pub use crate::report::sweep::*;
 
-use super::analyses::BifurcationRequest;
 use crate::analysis::bifurcation::SweepSpec;
-use serde_json::{json, Value};
-
-/// The fingerprint of a sweep: everything that determines its rows (the library's version,
-/// the resolved parameters, the swept parameter and its values, every sweep option); a sweep
-/// is resumed only with the same fingerprint. The worker threads are not part of it.
-///
-/// The values are `from`, `to`, `steps`, or `values` when the request lists them.
-pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
-    let mut doc = json!({
-        "afmdyn": env!("CARGO_PKG_VERSION"),
-        // how the sweep is cut into tasks and its starts keyed (issue 29): a store written by
-        // the two sequential chains of before is not resumed with segments
-        "plan": PLAN,
-        "params": spec.base,
-        "param": spec.param.name(),
-        "continuation": spec.continuation,
-        "starts": spec.starts,
-        "seed": spec.seed,
-        "tol": spec.steady.tol,
-        "max_periods": spec.steady.max_periods,
-        "max_period": spec.steady.max_period,
-        "integrator": spec.integrator.kind,
-        "steps_per_period": spec.integrator.steps_per_period,
-        "tolerance": spec.integrator.tolerance,
-    });
-    if let Some(map) = doc.as_object_mut() {
-        match &request.values {
-            Some(v) => {
-                map.insert("values".into(), json!(v));
-            }
-            None => {
-                map.insert("from".into(), json!(request.from));
-                map.insert("to".into(), json!(request.to));
-                map.insert("steps".into(), json!(request.steps));
-            }
-        }
-    }
-    doc
-}
+use serde_json::Value;
 
 /// The plan of a sweep's tasks in its fingerprint: chains cut into ⌈√n⌉ chunks seeded by a
 /// coarse pass, random starts keyed by (seed, value, start).

@@ -18,8 +18,7 @@ use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::report::basins::document;
 use crate::request::costs::{basins_cost, check_cost};
-use crate::request::limits::Cost;
-use crate::request::run::{Analysis, Request, Resolved};
+use crate::request::run::{Analysis, Resolved};
 use crate::request::BasinsRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
@@ -92,18 +91,6 @@ impl BasinStudy {
                 run_passes(&self.spec, &self.model, done, &store, cancel).map(|_| ())
             };
         Chain::new(&self.fingerprint, 0, run).weighted(units, |row| row.cells.len() as u64)
-    }
-}
-
-impl Request for BasinsRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "basins"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        basins_cost(&self.spec(&model.params)?)
     }
 }
 

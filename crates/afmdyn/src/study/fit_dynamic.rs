@@ -4,7 +4,7 @@
 //! [`crate::analysis::fit::fm_curve`], [`crate::analysis::fit::bimodal_curve`]), and its
 //! document, of the force-curve fit's shape ([`super::fit::document`]).
 
-use super::fit::{bounds, intervals_method, DynamicFit, FitResult};
+use super::fit_result::{bounds, intervals_method, DynamicFit, FitResult};
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe};
 use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
 use crate::analysis::fit::fm_curve::FmCurveModel;

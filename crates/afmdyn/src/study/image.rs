@@ -1,87 +1,35 @@
 //! `image` run ([`ImageJob`] as an [`Analysis`]): the request's data (`crate::request::image_job`)
-//! held against the budgets before any work ([`Request::cost`]: the materials' approach curves,
+//! held against the budgets before any work (`Request::cost`: the materials' approach curves,
 //! the pixels' memory and a scan's drive periods), run (the ideal feedback's image and setpoint
-//! study, [`super::scan::pi_image`], [`super::peakforce_image::peakforce_image`]) and presented
-//! (`crate::report::present::image`).
+//! study, [`super::scan::pi_image`], `super::peakforce_image::peakforce_image`) into an
+//! [`ImageOutput`] and presented (`crate::report::present::image`).
 
+use super::image_ideal::{image, setpoint_study};
+use super::scan::PiImage;
+#[cfg(feature = "files")]
+use super::scan::ScanStudy;
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::report::image::PeakForceImage;
 use crate::report::Presentation;
-use crate::request::image::{background_probe, curves_cost, image, setpoint_study};
-use crate::request::image_job::{ImageJob, ImageMode, ImageOutput};
-use crate::request::image_peakforce::{peakforce_cost, peakforce_probe};
-use crate::request::image_scan::resolve;
-use crate::request::limits::{check_threads, Cost};
+use crate::request::image::{Image, SetpointStudy};
+use crate::request::image_job::{ImageJob, ImageMode};
 use crate::request::run::{Analysis, Request, Resolved};
+use crate::study::named::Outcome;
 use serde_json::Value;
 
 impl ImageJob {
-    /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
-    /// setpoint force > 0, no PI feedback and no setpoint study.
-    fn validate_peakforce(&self) -> Result<(), SimError> {
-        if self.feedback.is_some() || self.study.is_some() {
-            return Err(SimError::out_of_range(
-                "mode",
-                "peakforce",
-                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
-                 setpoint study)",
-            ));
-        }
-        self.request.validate_grid(&self.sample)?;
-        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
-    }
-}
-
-impl Request for ImageJob {
-    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
-        self.request.validate(&self.sample)?;
-        check_threads(self.threads)?;
-        if self.mode == ImageMode::Peakforce {
-            return self.validate_peakforce();
-        }
-        let background = background_probe(&self.probe)?;
-        background.serves("image --mode am", crate::probe::ProbeNeeds::Tapping)?;
-        match (&self.feedback, &self.study) {
-            (Some(_), Some(_)) => Err(SimError::out_of_range(
-                "setpoint_study",
-                "a study with the PI feedback",
-                "only with the ideal feedback (a study of exact operating points)",
-            )),
-            (Some(scan), None) => {
-                resolve(&background, &self.sample, &self.request, scan).map(|_| ())
-            }
-            (None, _) => Ok(()),
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        "image"
-    }
-
-    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
-        if self.mode == ImageMode::Peakforce {
-            return peakforce_cost(&self.probe, &self.sample, &self.request);
-        }
-        let background = background_probe(&self.probe)?;
-        let (map, req) = (&self.sample, &self.request);
-        let periods = match &self.feedback {
-            Some(scan) => resolve(&background, map, req, scan)?.2,
-            None => 0.0,
-        };
-        let extra = Cost {
-            bytes: req.pixel_bytes(map),
-            work: periods,
-        };
-        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
-        if self.study.is_some() {
-            // the study computes the materials' curves once more
-            let none = Cost {
-                bytes: 0.0,
-                work: 0.0,
-            };
-            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
-        }
-        Ok(cost)
+    /// The PI scan's study (its materials' approach curves computed), for a front end that
+    /// runs it into a store of its own; `None` for the ideal feedback.
+    ///
+    /// # Errors
+    /// As [`ScanStudy::new`].
+    #[cfg(feature = "files")]
+    pub(crate) fn scan_study(&self) -> Result<Option<ScanStudy>, SimError> {
+        self.feedback
+            .as_ref()
+            .map(|scan| ScanStudy::new(&self.probe, &self.sample, &self.request, scan))
+            .transpose()
     }
 }
 
@@ -158,5 +106,112 @@ impl Analysis for ImageJob {
                 crate::report::present::image::peakforce(img, at.document, at.units)
             }
         })
+    }
+}
+
+/// An [`ImageJob`]'s result.
+// one value a run, its bulk on the heap: the variants' sizes do not matter
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum ImageOutput {
+    /// An ideal-feedback image and its setpoint study.
+    Ideal {
+        /// The image.
+        image: Image,
+        /// The setpoint study, when one was asked for.
+        study: Option<SetpointStudy>,
+    },
+    /// A PI-scanned image.
+    Pi(PiImage),
+    /// A PeakForce image (ideal peak-force feedback).
+    PeakForce(PeakForceImage),
+}
+
+impl ImageOutput {
+    /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
+    /// `image.nc`'s variables, `super::image_layout`) and, as the fact `summary`, the
+    /// command line's `image.json` ([`crate::report::present::image`]).
+    pub fn outcome(&self, setpoint: f64) -> Outcome {
+        use crate::report::image_layout::{layout, peakforce_layout, scan_layout};
+        use crate::report::present::image::{ideal_summary, peakforce_summary, pi_summary};
+        let (document, layout, summary) = match self {
+            ImageOutput::Ideal { image, study } => (
+                image.document(setpoint),
+                layout(image, setpoint),
+                ideal_summary(image, setpoint, study.as_ref()),
+            ),
+            ImageOutput::Pi(img) => (
+                img.document(setpoint),
+                scan_layout(img, setpoint),
+                pi_summary(img, setpoint),
+            ),
+            ImageOutput::PeakForce(img) => (
+                img.document(),
+                peakforce_layout(img),
+                peakforce_summary(img),
+            ),
+        };
+        let mut facts = serde_json::Map::new();
+        facts.insert("summary".into(), summary);
+        Outcome {
+            document,
+            datasets: vec![("image".into(), layout)],
+            facts,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::image_ideal::image;
+    use super::super::scan::ScanStudy;
+    use crate::error::SimError;
+    use crate::request::image::{ImageRequest, SampleMap};
+    use crate::request::image_scan::PiScan;
+
+    fn refused_as(e: SimError, what: &str) {
+        match &e {
+            SimError::Budget { what: w, .. } => assert_eq!(*w, what, "{e}"),
+            other => panic!("not a budget refusal: {other}"),
+        }
+        assert!(e.to_string().contains(what), "{e}");
+    }
+
+    /// An image whose pixels fit the pixel check but not with its approach curves' memory is
+    /// refused before the first curve, ideal and PI alike, naming the image.
+    #[test]
+    fn an_image_beyond_the_budget_is_refused_before_any_work() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/probe-point-mass-dmt.toml"
+        );
+        let table: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
+        let map = SampleMap {
+            size: (1e-6, 1e-6),
+            domains: vec![],
+            height_map: vec![],
+        };
+        // 1100 × 1072 pixels: 1.1792e9 B, within the pixels' own check (1.1 GiB)
+        let req = ImageRequest {
+            pixels: 1100,
+            lines: Some(1072),
+            ..ImageRequest::at(0.8)
+        };
+        req.validate(&map).unwrap();
+        let started = std::time::Instant::now();
+        refused_as(image(&table, &map, &req).unwrap_err(), "image");
+        // the fastest scan: a drive period per pixel
+        let probe = crate::probe::Probe::from_table(&table, "probe").unwrap();
+        let scan = PiScan {
+            scan_rate: Some(probe.drive_frequency / 2200.0),
+            gains: None,
+            time_constant: None,
+        };
+        match ScanStudy::new(&table, &map, &req, &scan) {
+            Err(e) => refused_as(e, "image"),
+            Ok(_) => panic!("a scan beyond the budget was accepted"),
+        }
+        // no curve ran: a curve of 120 points takes far longer in a debug build
+        assert!(started.elapsed().as_secs_f64() < 5.0);
     }
 }

@@ -61,15 +61,18 @@ pub(crate) mod checkpoint_file;
 mod datasets;
 pub(crate) mod fit;
 pub(crate) mod fit_dynamic;
+pub(crate) mod fit_result;
 pub(crate) mod fm;
 pub mod global_continuation;
-pub(crate) mod image;
+pub mod image;
+pub mod image_ideal;
 mod kinds;
 mod memory;
 pub(crate) mod modes;
 pub mod named;
 pub(crate) mod peakforce;
-pub(crate) mod peakforce_image;
+pub mod peakforce_image;
+pub(crate) mod peakforce_sweep;
 #[cfg(feature = "files")]
 pub mod plan;
 pub(crate) mod pool;
@@ -90,6 +93,7 @@ pub(crate) mod task_store;
 pub use analyses::advance_from_rest;
 pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
+pub use peakforce::PeakForceResult;
 pub(crate) use pool::in_pool;
 
 use crate::analysis::progress::Progress;

@@ -21,6 +21,8 @@
 
 use super::basins::BasinStudy;
 use super::named::{outcome, Outcome};
+use super::peakforce_image::{Engage, LinePixel, PeakForceImageStudy};
+use super::scan::{LineJob, ScanStudy};
 use super::stored::sweep_outcome;
 use super::sweep::{sweep_checkpoint, SweepCheckpoint};
 use super::task_store::{from_cbor_text, to_cbor_text};
@@ -30,12 +32,12 @@ use crate::analysis::basins::{pass_start, passes, run_pass_row, BasinRow, PassSt
 use crate::analysis::bifurcation::Resume;
 use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
 use crate::error::SimError;
+use crate::request::analyses::fingerprint;
 use crate::request::image::{ImageRequest, SampleMap};
 #[cfg(feature = "files")]
 use crate::request::image_job::ImageKeywords;
-use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
-use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
-use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
+use crate::request::image_scan::ScanRecipe;
+use crate::request::sweep::{every_point_failed, order_key, records, SweepRecord};
 use crate::request::{BasinsRequest, BifurcationRequest, DirLock, Resolved};
 use crate::Params;
 use nalgebra::DVector;
@@ -534,7 +536,7 @@ impl Plan for Image {
             .map(|t| decode::<(usize, ScanLine)>("result", t))
             .collect::<Result<Vec<_>, _>>()?;
         let img = self.study()?.assemble(lines)?;
-        Ok(crate::request::image_job::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
+        Ok(super::image::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
     }
 }
 
@@ -607,8 +609,7 @@ impl Plan for PfImage {
         let (engages, lines) = self.results(results)?;
         let study = self.study.clone().with_engages(engages);
         let img = study.assemble(lines)?;
-        Ok(crate::request::image_job::ImageOutput::PeakForce(img)
-            .outcome(self.study.request.setpoint))
+        Ok(super::image::ImageOutput::PeakForce(img).outcome(self.study.request.setpoint))
     }
 }
 

@@ -23,14 +23,14 @@ use std::sync::atomic::AtomicBool;
 pub struct SweepStudy {
     /// The validated sweep.
     pub spec: SweepSpec,
-    /// What a resumed sweep must match (`crate::request::sweep::fingerprint`).
+    /// What a resumed sweep must match (`crate::request::analyses::fingerprint`).
     pub fingerprint: Value,
 }
 
 impl SweepStudy {
     /// The study of `spec`, validated from `request`.
     pub fn new(request: &crate::request::BifurcationRequest, spec: SweepSpec) -> SweepStudy {
-        let fingerprint = crate::request::sweep::fingerprint(request, &spec);
+        let fingerprint = crate::request::analyses::fingerprint(request, &spec);
         SweepStudy { spec, fingerprint }
     }
 }

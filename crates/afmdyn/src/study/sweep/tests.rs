@@ -261,7 +261,7 @@ fn records_without_a_ledger_are_not_resumed() {
 #[test]
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     use crate::io::dir_lock::DirLock;
-    use crate::request::sweep::fingerprint;
+    use crate::request::analyses::fingerprint;
     use crate::study::checkpoint_file::{final_rows, LEDGER, PARTIAL_CSV};
     use crate::study::task_store::TaskStore;
     let r = request();
