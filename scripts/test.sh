@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The test command (README "Tests"; .ci/run calls it):
 #   1. the Rust tests: cargo test --workspace --release --no-fail-fast (every test binary runs,
-#      so one failure does not hide the others), and the toy contact law's test (feature toy-law)
+#      so one failure does not hide the others), and the toy contact law's test (feature toy-law,
+#      run in the background beside pytest, with the toy-law wheel and the browser suites'
+#      builds, scripts/prepare-browser.sh: pytest leaves a core mostly idle)
 #   2. the Python package: a virtual environment in target/venv-test (created once, reused;
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it, reusing the
@@ -30,18 +32,6 @@ extra_failed=0
 echo "== Rust: cargo test --workspace --release --no-fail-fast"
 cargo test --workspace --release --no-fail-fast 2>&1 | tee "$logs/rust.log"
 rust_code=${PIPESTATUS[0]}
-# the toy contact law (feature toy-law, not shipped): a law is one file plus one registry line
-# (--workspace: the dependencies' features as the toy-law wheel's below, which then reuses the library)
-echo "== Rust: cargo test --release --workspace --features afmdyn/toy-law --test toy_law"
-cargo test --release --workspace --features afmdyn/toy-law --test toy_law 2>&1 | tee -a "$logs/rust.log"
-[ "${PIPESTATUS[0]}" -eq 0 ] || rust_code=1
-rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
-rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
-if [ "$rust_code" -ne 0 ]; then
-    status=1
-    # a build failure runs no test: count it as one failure
-    [ "$rust_failed" -gt 0 ] || extra_failed=$((extra_failed + 1))
-fi
 
 echo "== Python: virtual environment $VENV"
 if [ ! -x "$VENV/bin/python" ]; then
@@ -54,10 +44,32 @@ fi
 py="$VENV/bin/python"
 py_passed=0
 py_failed=0
+toy="$logs/toy"
+# Beside pytest, which leaves a core mostly idle, in the background: the toy contact law
+# (feature toy-law, not shipped: a law is one file plus one registry line) — its Rust test
+# (--workspace: the dependencies' features as the wheel's, which then reuses the library) and
+# its wheel, installed beside the venv's packages, not into them — then the browser suites'
+# tools and builds (scripts/prepare-browser.sh). Its output is printed after pytest.
+background() {
+    echo "== Rust: cargo test --release --workspace --features afmdyn/toy-law --test toy_law"
+    cargo test --release --workspace --features afmdyn/toy-law --test toy_law > "$logs/toy-rust.log" 2>&1
+    echo $? > "$logs/toy-rust.code"
+    cat "$logs/toy-rust.log"
+    if [ -x "$py" ]; then
+        echo "== Python: the toy-law wheel (feature toy-law)"
+        MATURIN_PEP517_ARGS="--features toy-law" "$py" -m pip wheel -q --no-deps -w "$toy/wheel" ./crates/afmdyn-py &&
+            "$py" -m pip install -q --no-deps --target "$toy/site" "$toy"/wheel/*.whl &&
+            touch "$toy/built"
+    fi
+    echo "== the browser suites' tools and builds: bash scripts/prepare-browser.sh"
+    bash scripts/prepare-browser.sh
+}
 if [ -x "$py" ]; then
     "$py" -m pip install -q --upgrade pip 2>&1 | tail -1
     echo "== Python: pip install ./crates/afmdyn-py[test] (maturin builds the extension)"
     if "$py" -m pip install -q "./crates/afmdyn-py[test]"; then
+        background > "$logs/background.log" 2>&1 &
+        bg=$!
         echo "== Python: pytest crates/afmdyn-py/tests"
         AFMDYN_BIN="$TARGET/release/afmdyn" "$py" -m pytest crates/afmdyn-py/tests -p no:cacheprovider -rs 2>&1 |
             tee "$logs/py.log"
@@ -72,13 +84,11 @@ if [ -x "$py" ]; then
             echo "pytest exited with status $code"
             extra_failed=$((extra_failed + 1))
         fi
-        # the toy contact law from Python: a second wheel built with the feature toy-law
-        # (reusing the library the Rust toy-law test compiled), installed beside the venv's
-        # packages, not into them; tests/test_toy_law.py runs against it
-        echo "== Python: the toy law (a wheel with feature toy-law, tests/test_toy_law.py)"
-        toy="$logs/toy"
-        if MATURIN_PEP517_ARGS="--features toy-law" "$py" -m pip wheel -q --no-deps -w "$toy/wheel" ./crates/afmdyn-py &&
-            "$py" -m pip install -q --no-deps --target "$toy/site" "$toy"/wheel/*.whl; then
+        wait "$bg"
+        cat "$logs/background.log"
+        # the toy contact law from Python: tests/test_toy_law.py against the toy-law wheel
+        echo "== Python: the toy law (tests/test_toy_law.py against the toy-law wheel)"
+        if [ -e "$toy/built" ]; then
             AFMDYN_TOY_LAW=1 PYTHONPATH="$toy/site" AFMDYN_BIN="$TARGET/release/afmdyn" \
                 "$py" -m pytest crates/afmdyn-py/tests/test_toy_law.py -p no:cacheprovider 2>&1 | tee "$logs/toy.log"
             code=${PIPESTATUS[0]}
@@ -104,6 +114,20 @@ if [ -x "$py" ]; then
 else
     status=1
     extra_failed=$((extra_failed + 1))
+fi
+# the background's work when pytest did not run
+if [ -z "${bg:-}" ]; then
+    background > "$logs/background.log" 2>&1
+    cat "$logs/background.log"
+fi
+[ "$(cat "$logs/toy-rust.code" 2>/dev/null)" = 0 ] || rust_code=1
+cat "$logs/toy-rust.log" >> "$logs/rust.log" 2>/dev/null
+rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
+rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
+if [ "$rust_code" -ne 0 ]; then
+    status=1
+    # a build failure runs no test: count it as one failure
+    [ "$rust_failed" -gt 0 ] || extra_failed=$((extra_failed + 1))
 fi
 
 # a suite whose script prints "NAME: N passed, M failed" last: its counts into NAME_passed and
