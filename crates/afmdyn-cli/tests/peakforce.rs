@@ -205,6 +205,45 @@ fn a_peakforce_image_carries_the_probes_tabor_warning() {
     );
 }
 
+/// A PeakForce image whose setpoint no material reaches is an error (exit 1) naming the
+/// setpoint in newtons, not an image of no finite pixel written with exit 0 (issue 77 §3: 0.7,
+/// the AM ratio typed by habit, or 1e-30 N).
+#[test]
+fn a_peakforce_image_no_material_reaches_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = common::flat_sample(dir.path());
+    for setpoint in ["0.7", "1e-30"] {
+        let out = afmdyn(&[
+            "image",
+            "--mode",
+            "peakforce",
+            "--probe",
+            AIR,
+            "--sample",
+            sample.to_str().unwrap(),
+            "--pixels",
+            "1",
+            "--setpoint",
+            setpoint,
+            "--json",
+            "--files",
+            "none",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{setpoint}: {err}");
+        assert!(out.stdout.is_empty(), "{setpoint}: a document was written");
+        assert!(
+            err.contains("no pixel of the image reaches it"),
+            "{setpoint}: {err}"
+        );
+        let newtons: f64 = setpoint.parse().unwrap();
+        assert!(
+            err.contains(&format!("{newtons:e}")) || err.contains(setpoint),
+            "{err}"
+        );
+    }
+}
+
 /// A soft, adhesive sample the tip indents while the force stays attractive: the warning says
 /// so, not that the sample never reaches the tip beside an indentation past R/2 (issue 77).
 #[test]

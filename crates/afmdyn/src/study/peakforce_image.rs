@@ -138,7 +138,9 @@ impl PeakForceImageStudy {
     /// the materials' models and their engages from far (module docs).
     ///
     /// # Errors
-    /// As `PeakForceImageStudy::unengaged`; [`SimError::Cancelled`].
+    /// As `PeakForceImageStudy::unengaged`; [`SimError::Cancelled`];
+    /// [`SimError::EveryRunFailed`] when no material reaches the setpoint
+    /// ([`PeakForceImageStudy::reached`]).
     pub fn new(
         probe_table: &toml::Table,
         map: &SampleMap,
@@ -148,7 +150,28 @@ impl PeakForceImageStudy {
         let engages = (0..study.materials.len())
             .map(|m| study.engage(m))
             .collect::<Result<Vec<_>, SimError>>()?;
+        study.reached(&engages)?;
         Ok(study.with_engages(engages))
+    }
+
+    /// That some material reaches the setpoint from far: an image none of whose materials
+    /// does would have no finite pixel in any map (issue 77 §3: it was written as a result).
+    ///
+    /// # Errors
+    /// [`SimError::EveryRunFailed`] naming the first material and why, before any line.
+    pub(crate) fn reached(&self, engages: &[Engage]) -> Result<(), SimError> {
+        if engages.iter().any(|(_, e)| e.is_ok()) {
+            return Ok(());
+        }
+        let first = (self.materials.iter().zip(engages))
+            .find_map(|(m, (_, e))| e.as_ref().err().map(|e| format!("{}: {e}", m.name)))
+            .unwrap_or_default();
+        Err(SimError::EveryRunFailed {
+            what: "materials' engages at the setpoint (no pixel of the image reaches it, so no \
+                   map would have a value)",
+            runs: engages.len(),
+            first,
+        })
     }
 
     /// The study before its materials' engages ([`PeakForceImageStudy::engage`], then

@@ -589,10 +589,14 @@ impl Plan for PfImage {
                 start: encode(&None::<Vec<Engage>>)?,
                 tasks: (0..self.study.materials.len()).collect(),
             }),
-            1 => Ok(Stage {
-                start: encode(&Some(self.results(results)?.0))?,
-                tasks: (0..self.study.lines()).collect(),
-            }),
+            1 => {
+                let engages = self.results(results)?.0;
+                self.study.reached(&engages)?;
+                Ok(Stage {
+                    start: encode(&Some(engages))?,
+                    tasks: (0..self.study.lines()).collect(),
+                })
+            }
             _ => Err(no_stage(stage, 2)),
         }
     }
