@@ -140,7 +140,7 @@ impl PeakForceImageStudy {
     /// # Errors
     /// As `PeakForceImageStudy::unengaged`; [`SimError::Cancelled`];
     /// [`SimError::EveryRunFailed`] when no material reaches the setpoint
-    /// ([`PeakForceImageStudy::reached`]).
+    /// (`PeakForceImageStudy::reached`).
     pub fn new(
         probe_table: &toml::Table,
         map: &SampleMap,
