@@ -33,6 +33,11 @@ echo "== Rust: cargo test --workspace --release --no-fail-fast"
 cargo test --workspace --release --no-fail-fast 2>&1 | tee "$logs/rust.log"
 rust_code=${PIPESTATUS[0]}
 
+# wasm-bindgen-cli for the browser suites (scripts/wasm-bindgen.sh: in its own build directory,
+# so it never waits for the workspace's) while the Python packages download and install
+bash scripts/wasm-bindgen.sh > "$logs/bindgen.log" 2>&1 &
+bindgen_job=$!
+
 echo "== Python: virtual environment $VENV"
 if [ ! -x "$VENV/bin/python" ]; then
     mkdir -p "$(dirname "$VENV")"
@@ -129,6 +134,9 @@ if [ "$rust_code" -ne 0 ]; then
     # a build failure runs no test: count it as one failure
     [ "$rust_failed" -gt 0 ] || extra_failed=$((extra_failed + 1))
 fi
+
+wait "$bindgen_job"
+cat "$logs/bindgen.log"
 
 # a suite whose script prints "NAME: N passed, M failed" last: its counts into NAME_passed and
 # NAME_failed; a non-zero exit without a counted failure counts as one
