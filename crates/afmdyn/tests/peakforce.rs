@@ -530,6 +530,27 @@ fn peakforce_filter_on_the_measured_force() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("filter_cutoff"), "{e}");
+    // from the modulation frequency up the filtered force is finite; far below it (1e-308 Hz)
+    // it was written as nulls with no warning (issue 77 §3): refused, naming the bound
+    let fm = 1.0 / doc["modulation"]["period"].as_f64().unwrap();
+    let low = run(serde_json::json!({"filter_cutoff": 1.001 * fm})).unwrap();
+    let finite = |k: &str| {
+        low.document["curve"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|v| v.is_f64())
+    };
+    assert!(finite("approach_filtered_force") && finite("retract_filtered_force"));
+    for fc in [1e-308, 0.5 * fm] {
+        let e = run(serde_json::json!({"filter_cutoff": fc}))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("filter_cutoff") && e.contains("modulation frequency"),
+            "{e}"
+        );
+    }
 }
 
 /// A constant passes unchanged (unit DC gain); a sinusoid at the cut-off leaves with the

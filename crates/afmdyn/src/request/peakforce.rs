@@ -135,15 +135,21 @@ impl PeakForceRequest {
         }
         self.options().validate()?;
         if let Some(fc) = self.filter_cutoff {
-            // the cycle's sampling interval in the document's time unit (s with a probe)
-            let nyquist = 0.5 / self.sampling_interval(model, &p);
-            if !(fc.is_finite() && fc > 0.0 && fc < nyquist) {
+            // the cycle's sampling interval in the document's time unit (s with a probe), its
+            // period's frequency (the modulation's) and the samples' Nyquist frequency; below
+            // the modulation frequency the filter leaves little but the cycle's mean, and far
+            // below it (1e-308) its periodic steady state is singular (issue 77 §3)
+            let dt = self.sampling_interval(model, &p);
+            let (modulation, nyquist) = (1.0 / (dt * self.samples as f64), 0.5 / dt);
+            if !(fc.is_finite() && fc >= modulation && fc < nyquist) {
                 return Err(SimError::out_of_range(
                     "filter_cutoff",
                     fc,
                     format!(
-                        "must be a cut-off frequency > 0 below the Nyquist frequency of the \
-                         cycle's samples, {nyquist:.6e} (raise samples to raise it)"
+                        "must be a cut-off frequency from the modulation frequency, \
+                         {modulation:.6e} (below it the filter leaves little but the cycle's \
+                         mean), to below the Nyquist frequency of the cycle's samples, \
+                         {nyquist:.6e} (raise samples to raise it)"
                     ),
                 ));
             }
