@@ -245,12 +245,13 @@ pub(crate) fn image_curves_cost(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::error::SimError;
     use crate::params::Params;
     use crate::request::{ChartRequest, ModelSpec};
 
-    fn refused_as(e: SimError, what: &str) {
+    /// `e` is a budget refusal of `what`, naming it.
+    pub(crate) fn refused_as(e: SimError, what: &str) {
         match &e {
             SimError::Budget { what: w, .. } => assert_eq!(*w, what, "{e}"),
             other => panic!("not a budget refusal: {other}"),

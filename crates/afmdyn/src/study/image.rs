@@ -165,17 +165,9 @@ impl ImageOutput {
 mod tests {
     use super::super::image_ideal::image;
     use super::super::scan::ScanStudy;
-    use crate::error::SimError;
+    use crate::request::costs::tests::refused_as;
     use crate::request::image::{ImageRequest, SampleMap};
     use crate::request::image_scan::PiScan;
-
-    fn refused_as(e: SimError, what: &str) {
-        match &e {
-            SimError::Budget { what: w, .. } => assert_eq!(*w, what, "{e}"),
-            other => panic!("not a budget refusal: {other}"),
-        }
-        assert!(e.to_string().contains(what), "{e}");
-    }
 
     /// An image whose pixels fit the pixel check but not with its approach curves' memory is
     /// refused before the first curve, ideal and PI alike, naming the image.
