@@ -52,8 +52,7 @@ pub fn image<'py>(
     let job = keywords.job(probe).map_err(sim_error)?;
     let model = job.model().map_err(sim_error)?;
     job.validate(&model).map_err(sim_error)?;
-    let cancellable = job.feedback.is_some();
-    crate::door::run_outcome(py, progress, cancellable, move |p| {
+    crate::door::run_outcome(py, progress, move |p| {
         request::run(&job, &model, p).map(|doc| doc.output.outcome(setpoint))
     })
 }

@@ -6,7 +6,7 @@
 use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::{model_spec, PyParams};
-use crate::run::{run, Job, Stop};
+use crate::run::{run, Job};
 use afmdyn::probe::Probe;
 use afmdyn::request::chart::Chart;
 use afmdyn::request::Params;
@@ -236,7 +236,6 @@ impl ChartStudy {
             &job,
             Some(total),
             progress.as_ref(),
-            Stop::Cancellable,
             move || -> PyResult<Vec<ChartCell>> {
                 // the command line's run into its store (the library's one path)
                 let storage = Storage {

@@ -10,7 +10,7 @@ use crate::convert::{json_to_py, layout_dict};
 use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
-use crate::run::{run as run_job, Job, Stop};
+use crate::run::{run as run_job, Job};
 use afmdyn::error::SimError;
 use afmdyn::probe::{Probe, ProbeNeeds};
 use afmdyn::request::Params;
@@ -53,26 +53,19 @@ pub fn run<'py>(
     let named = crate::convert::named(name, request)?;
     let model = resolved(params, probe, named.probe_needs())?;
     named.validate(&model).map_err(sim_error)?;
-    let cancellable = named.checks_cancel();
-    run_outcome(py, progress, cancellable, move |p| named.run(&model, p))
+    run_outcome(py, progress, move |p| named.run(&model, p))
 }
 
-/// Run `work` without the GIL ([`crate::run`]; `cancellable`: it checks its progress' cancel
-/// flag, else it is abandoned on an interrupt) to the dict of its outcome ([`outcome_dict`]).
+/// Run `work` without the GIL ([`crate::run`]: an interrupt cancels its progress and waits
+/// for it to stop) to the dict of its outcome ([`outcome_dict`]).
 pub fn run_outcome<'py>(
     py: Python<'py>,
     progress: Option<Bound<'py, PyAny>>,
-    cancellable: bool,
     work: impl FnOnce(&Progress) -> Result<Outcome, SimError> + Send + 'static,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let stop = if cancellable {
-        Stop::Cancellable
-    } else {
-        Stop::Abandon
-    };
     let job = Job::default();
     let worker = job.clone();
-    let outcome = run_job(py, &job, None, progress.as_ref(), stop, move || {
+    let outcome = run_job(py, &job, None, progress.as_ref(), move || {
         work(&worker.progress)
     })?
     .map_err(sim_error)?;
@@ -108,14 +101,9 @@ pub fn run_stored(
     // the call is attached to the interpreter already: its token from there, not as an
     // eighth argument
     Python::attach(|py| {
-        let outcome = run_job(
-            py,
-            &job,
-            None,
-            progress.as_ref(),
-            Stop::Cancellable,
-            move || study.run(lock.as_ref(), resume, &worker.progress),
-        )?
+        let outcome = run_job(py, &job, None, progress.as_ref(), move || {
+            study.run(lock.as_ref(), resume, &worker.progress)
+        })?
         .map_err(study_error)?;
         outcome_dict(py, outcome).map(Bound::unbind)
     })

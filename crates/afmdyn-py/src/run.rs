@@ -8,7 +8,7 @@
 //! SIGINT handler (`afmdyn/_interrupt.py`, wrapping the one it finds) bumps it through
 //! [`cancel_running`] before it raises `KeyboardInterrupt` in the main thread, and so does a
 //! `KeyboardInterrupt` raised in a wait on the main thread. A computation sees the count move
-//! past the value it started with at its next poll: it is cancelled (or abandoned) and its
+//! past the value it started with at its next poll: it is cancelled and its
 //! caller gets `KeyboardInterrupt`, whatever thread it runs in.
 
 use afmdyn::request::Progress;
@@ -44,16 +44,6 @@ pub struct Job {
     pub progress: Arc<Progress>,
 }
 
-/// How the computation reacts to an interrupt.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Stop {
-    /// It checks [`Job::cancel`]: wait for it to stop, then raise.
-    Cancellable,
-    /// It cannot stop early: raise at once and let the worker finish in the background (its
-    /// result is dropped; it holds no Python objects).
-    Abandon,
-}
-
 fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
     if let Some(s) = p.downcast_ref::<&str>() {
         (*s).to_string()
@@ -77,7 +67,6 @@ pub fn run<T, F>(
     job: &Job,
     total: Option<usize>,
     progress: Option<&Bound<'_, PyAny>>,
-    stop: Stop,
     work: F,
 ) -> PyResult<T>
 where
@@ -142,11 +131,10 @@ where
                 // Ctrl-C here (the main thread) cancels the runs of the other threads too
                 cancel_running();
             }
+            // every run of the library's door stops within a second of its cancel
+            // (afmdyn's tests/door.rs): waited for, so that nothing runs on in the background
             job.progress.cancel();
-            if stop == Stop::Cancellable {
-                // the points already running finish; no new one starts
-                let _ = py.detach(|| rx.lock().expect("receiver").recv());
-            }
+            let _ = py.detach(|| rx.lock().expect("receiver").recv());
             return Err(e);
         }
     }

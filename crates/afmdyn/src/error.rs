@@ -1,5 +1,8 @@
 //! Typed errors of the library. Every message names the offending field and the allowed range.
 
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use thiserror::Error;
 
 /// A model parameter outside its allowed range (see [`crate::Params`]).
@@ -383,5 +386,47 @@ pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SimError> {
         Ok(value)
     } else {
         Err(SimError::NotFinite { name, value })
+    }
+}
+
+// The cancel flag a run's loops watch (`crate::analysis::progress`: the door installs it,
+// every loop that integrates checks it), here below the integrators that check it.
+thread_local! {
+    /// The cancel flag of the run on this thread (`Progress::watch`).
+    static WATCHED: RefCell<Option<Arc<AtomicBool>>> = const { RefCell::new(None) };
+}
+
+/// The cancel flag this thread watches, to carry onto another thread ([`watching`]).
+pub(crate) fn watched() -> Option<Arc<AtomicBool>> {
+    WATCHED.with(|w| w.borrow().clone())
+}
+
+/// Run `f` with `flag` as this thread's watched cancel flag, the one before restored after.
+pub(crate) fn watching<T>(flag: Option<Arc<AtomicBool>>, f: impl FnOnce() -> T) -> T {
+    struct Restore(Option<Arc<AtomicBool>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let before = self.0.take();
+            WATCHED.with(|w| *w.borrow_mut() = before);
+        }
+    }
+    let _restore = Restore(WATCHED.with(|w| w.replace(flag)));
+    f()
+}
+
+/// `Ok` while the run on this thread may go on (no flag watched, or not set).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once the watched flag is set.
+pub(crate) fn cancelled() -> Result<(), SimError> {
+    let set = WATCHED.with(|w| {
+        w.borrow()
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    });
+    if set {
+        Err(SimError::Cancelled)
+    } else {
+        Ok(())
     }
 }

@@ -52,8 +52,8 @@
 //! * The integration tests (`crates/afmdyn/tests/main.rs` and its modules) are compiled inside
 //!   the crate, as the module `integration` of its test build: they reach `pub(crate)` items
 //!   and so do not make an item public. Two stay binaries of their own, outside the crate:
-//!   `tests/allocations.rs` (a counting global allocator) and `tests/toy_law.rs` (a law added as
-//!   an outside user would).
+//!   `tests/door.rs` (a counting global allocator: the door over every request) and
+//!   `tests/toy_law.rs` (a law added as an outside user would).
 //! * Everything else is `pub(crate)`: an item is public only when one of those names it or a
 //!   public item's signature shows it.
 //!

@@ -367,6 +367,7 @@ pub(crate) fn record_rows(
     }
     let mut balance = Balance::new(&model, integ, (k_period as f64) * period);
     while integ.tau() < end {
+        crate::error::cancelled()?;
         let next_section = k_period as f64 * period;
         // a span proven free of body contact is checked at its end only
         let step = crate::integrate::step_span(integ, end.min(next_section), body.as_ref())?;

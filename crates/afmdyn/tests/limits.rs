@@ -329,9 +329,9 @@ mod costs {
         };
         within("basins", basins(666_666).cost(&model()).unwrap());
         refused(&basins(666_667), "1e11 mode-periods");
-        // a curve's traces: 1000 points × 16 periods × 24 bytes × samples per period, 2.5
-        // times while they are recorded: 1000 samples take 0.96 GB, 2000 1.9 GB (and 0.77 GB
-        // by the traces' own budget of 1 GiB, which lets them through)
+        // a curve's traces: 1000 points × 16 periods × 24 bytes × samples per period, 3.5
+        // times while they are recorded and laid out: 700 samples take 0.94 GB, 1000 1.34 GB
+        // (and 0.38 GB by the traces' own budget of 1 GiB, which lets them through)
         let traced = |samples| afmdyn::request::CurveRequest {
             points: Some(1000),
             branches: false,
@@ -339,12 +339,12 @@ mod costs {
             ..afmdyn::request::CurveRequest::default()
         };
         let approach = ApproachRequest {
-            curve: traced(1000),
+            curve: traced(700),
             ..ApproachRequest::default()
         };
         within("approach", approach.cost(&model()).unwrap());
         let approach = ApproachRequest {
-            curve: traced(2000),
+            curve: traced(1000),
             ..ApproachRequest::default()
         };
         refused(&approach, "1.1 GiB");

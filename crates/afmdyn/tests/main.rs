@@ -2,9 +2,9 @@
 //! its test build (src/lib.rs; they reach `pub(crate)` items): each tests/*.rs file is a module
 //! here, so `cargo test -p afmdyn --lib integration::fm::` runs
 //! tests/fm.rs. The modules that read probe files need the `files` feature and those that set
-//! rayon's thread count `parallel`. Two files are binaries of their own: tests/allocations.rs
-//! (a counting global allocator, the peak heap over all threads) and tests/toy_law.rs (feature
-//! `toy-law`).
+//! rayon's thread count `parallel`. Two files are binaries of their own: tests/door.rs (a
+//! counting global allocator, the peak heap over all threads, and cancels timed) and
+//! tests/toy_law.rs (feature `toy-law`).
 
 // the helpers the files share (tests/common/)
 mod common;

@@ -311,6 +311,8 @@ fn steady_states_of_starts(
     cancel: &AtomicBool,
     tick: &(dyn Fn() + Sync),
 ) -> Vec<StartResult> {
+    // each start watches the caller's cancel flag too (`crate::analysis::progress`)
+    let watched = crate::error::watched();
     starts
         .into_par_iter()
         .with_max_len(1)
@@ -318,7 +320,9 @@ fn steady_states_of_starts(
             let r = if cancel.load(Ordering::Relaxed) {
                 Err(SimError::Cancelled)
             } else {
-                steady_state_of(model, spec.integrator.clone(), &z0, &spec.steady)
+                crate::error::watching(watched.clone(), || {
+                    steady_state_of(model, spec.integrator.clone(), &z0, &spec.steady)
+                })
             };
             tick();
             (z0, r)

@@ -512,13 +512,17 @@ pub(crate) fn run_passes(
     cancel: &AtomicBool,
 ) -> Result<Vec<BasinRow>, SimError> {
     let mut rows = stored.to_vec();
+    // each row watches the caller's cancel flag too (`crate::analysis::progress`)
+    let watched = crate::error::watched();
     for pass in 0..passes(spec) {
         let start = pass_start(spec, &rows, pass);
         let done: Vec<BasinRow> = (&start.rows)
             .into_par_iter()
             .with_max_len(1)
             .map(|(iy, columns)| {
-                let row = run_pass_row(spec, model, &start, *iy, columns, cancel)?;
+                let row = crate::error::watching(watched.clone(), || {
+                    run_pass_row(spec, model, &start, *iy, columns, cancel)
+                })?;
                 sink(&row);
                 Ok(row)
             })

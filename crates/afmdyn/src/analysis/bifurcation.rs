@@ -471,8 +471,14 @@ pub(crate) fn run_sweep_cancellable(
 ) {
     let plan = SweepPlan::new(spec);
     let seeds = plan.seeds(resume, cancel);
+    // each task watches the caller's cancel flag too (`crate::analysis::progress`)
+    let watched = crate::error::watched();
     plan.tasks(1)
         .into_par_iter()
         .with_max_len(1)
-        .for_each(|task| plan.run_task(task, &seeds, resume, sink, cancel));
+        .for_each(|task| {
+            crate::error::watching(watched.clone(), || {
+                plan.run_task(task, &seeds, resume, sink, cancel)
+            })
+        });
 }

@@ -121,7 +121,7 @@ impl PeakForceOptions {
 }
 
 /// One period of the steady tap, sampled uniformly from the largest separation (t = 0).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Cycle {
     /// t = τ − T/4 from the largest separation, τ units, shape `[samples]`.
     pub time: Vec<f64>,

@@ -6,16 +6,25 @@
 //! later a Dask worker's heartbeat — and sets the flag to stop the run, which then returns
 //! [`SimError::Cancelled`]. Everything is an atomic: a parallel analysis ticks from every
 //! worker without a lock, and the results never depend on when (or whether) anyone reads.
+//!
+//! A cancel reaches every loop that integrates, not only those that take the flag: the door
+//! runs an analysis under `Progress::watch`, which makes the flag this thread's watched one,
+//! and [`crate::integrate::advance`], the steady-state search, Newton's chunks from the
+//! transient and the recording of a trajectory end with [`SimError::Cancelled`] at their next
+//! step once it is set (`crate::error::cancelled`). A study's executor carries the watched flag
+//! onto its pool (`crate::error::watched`, `watching`) and stores nothing after a cancel, so
+//! that a task cut short is never kept as a result.
 
-use crate::error::SimError;
+use crate::error::{watching, SimError};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 /// The progress counter and cancel flag of one run (see the module docs).
 #[derive(Debug, Default)]
 pub struct Progress {
     done: AtomicUsize,
     total: AtomicUsize,
-    cancel: AtomicBool,
+    cancel: Arc<AtomicBool>,
 }
 
 impl Progress {
@@ -58,6 +67,10 @@ impl Progress {
     /// ([`crate::analysis::bifurcation::run_sweep_cancellable`]).
     pub(crate) fn cancel_flag(&self) -> &AtomicBool {
         &self.cancel
+    }
+    /// Run `f` with this run's cancel flag watched on this thread (`crate::error::cancelled`).
+    pub(crate) fn watch<T>(&self, f: impl FnOnce() -> T) -> T {
+        watching(Some(self.cancel.clone()), f)
     }
     /// `Ok` while the run may go on.
     ///

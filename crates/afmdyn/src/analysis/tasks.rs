@@ -25,6 +25,8 @@ pub(crate) fn run_independent<R, E: Send>(
     cancel: &AtomicBool,
 ) -> Result<(), E> {
     let failed = Mutex::new(None::<(usize, E)>);
+    // each task watches the caller's cancel flag too (`crate::analysis::progress`)
+    let watched = crate::error::watched();
     (0..tasks)
         .into_par_iter()
         .with_max_len(1)
@@ -33,7 +35,7 @@ pub(crate) fn run_independent<R, E: Send>(
             if cancel.load(Ordering::Relaxed) {
                 return;
             }
-            match task(t) {
+            match crate::error::watching(watched.clone(), || task(t)) {
                 Ok(Some(r)) => sink(t, r),
                 Ok(None) => {}
                 Err(e) => {

@@ -515,11 +515,13 @@ pub(crate) fn tip_values(integ: &mut dyn Integrator) -> [f64; 4] {
 /// As [`Integrator::step`]; [`SimError::NotFinite`] for a non-finite `tau_end`.
 pub fn advance(integ: &mut dyn Integrator, tau_end: f64) -> Result<(), SimError> {
     crate::error::finite("tau_end", tau_end)?;
+    crate::error::cancelled()?;
     if let Some(s) = integ.spans() {
         return s.advance_to(tau_end);
     }
     while integ.tau() < tau_end {
         integ.step(tau_end)?;
+        crate::error::cancelled()?;
     }
     Ok(())
 }
@@ -542,6 +544,7 @@ pub fn advance_dyn(
             .copy_from_slice(integ.state().as_slice());
         let step = integ.step(tau_end)?;
         on_step(integ, &step, &before)?;
+        crate::error::cancelled()?;
     }
     Ok(())
 }
@@ -669,6 +672,7 @@ pub fn advance_observed(
                 None => integ.step(tau_end)?,
             };
             obs.step(&mut Observed { integ: &mut *integ }, &step)?;
+            crate::error::cancelled()?;
         }
         Ok(())
     };

@@ -130,17 +130,16 @@ impl NamedRequest {
             Simulate(s) => s.validate_in_memory(&model.params).map(|_| ()),
             ReconstructDocument(f) => FromDocument::validate(f))
     }
-    /// Whether the run counts its work in its progress and stops at a cancel (`false` for
-    /// one short computation, or a recording that cannot stop early).
-    pub fn checks_cancel(&self) -> bool {
-        !matches!(
-            self.0,
-            Parsed::Modes(_)
-                | Parsed::Orbit(_)
-                | Parsed::Observe(_)
-                | Parsed::Fit(_)
-                | Parsed::Simulate(_)
-        )
+    /// What the request costs on `model` ([`super::Request::cost`]; `simulate`'s is its
+    /// recording's, [`SimulateRequest::in_memory_cost`]); `None` for `reconstruct_document`,
+    /// whose cost is its reconstruction's, known once its document is read.
+    ///
+    /// # Errors
+    /// The request's validation errors.
+    pub fn cost(&self, model: &Resolved) -> Result<Option<super::limits::Cost>, SimError> {
+        each_request!(&self.0, r => r.cost(model).map(Some),
+            Simulate(s) => s.in_memory_cost(&model.params).map(Some),
+            ReconstructDocument(_f) => Ok(None))
     }
     /// What the request uses of a probe ([`super::Request::probe_needs`]).
     pub fn probe_needs(&self) -> crate::probe::ProbeNeeds {

@@ -331,23 +331,30 @@ impl Request for PeakForceRequest {
                 + newton_work(q, 1, &opts.shooting))
                 * lever_periods)
         };
-        let tap = match &self.sweep {
-            Some(s) => self
-                .sweep_points(s, model, &p)?
-                .iter()
-                .map(tap_work)
-                .sum::<Result<f64, SimError>>()?,
-            None => tap_work(&p)?,
+        let points = match &self.sweep {
+            Some(s) => self.sweep_points(s, model, &p)?,
+            None => vec![p],
         };
+        let tap = points.iter().map(tap_work).sum::<Result<f64, SimError>>()?;
         let per_value = if self.setpoint.is_some() {
             (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
         } else {
             1.0
         };
         let taps = per_value;
-        let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
+        let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
+        // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
+        // fits, multipliers and state, and the value's model
+        let record = 2048.0 + 8.0 * state_bytes(&p) + std::mem::size_of::<Params>() as f64;
+        // a sample of the cycle and its force curve, with the document's numbers and the
+        // outcome's arrays: 640 bytes (measured 490 at 2048 and 8192 samples, `tests/door.rs`);
+        // the fit's resampled curve, 4 columns of 8 bytes twice
         Ok(Cost {
-            bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
+            bytes: MODEL_BYTES
+                + self.samples as f64 * 640.0
+                + fit * 64.0
+                + 64.0 * state_bytes(&p)
+                + points.len() as f64 * record,
             work: taps * tap,
         })
     }

@@ -190,7 +190,9 @@ pub fn run_admitted<A: Analysis + ?Sized>(
     progress: &Progress,
 ) -> Result<Document<A::Output>, SimError> {
     progress.check()?;
-    let output = analysis.execute(model, progress)?;
+    let output = progress.watch(|| analysis.execute(model, progress))?;
+    // a run cancelled midway may have turned the cancel into failed parts: never a result
+    progress.check()?;
     Ok(Document {
         json: document(analysis, model, &output)?,
         output,

@@ -177,4 +177,20 @@ impl SimulateRequest {
     pub fn validate_in_memory(&self, params: &Params) -> Result<SimulateSpan, SimError> {
         self.validate(params, SeriesStore::Memory, 7 + params.state_dim(), 8.0)
     }
+    /// What a recording held whole in memory costs: its samples as
+    /// [`crate::trajectory::record`] grows them (`request::costs::recorded_sample_bytes` ×
+    /// `TRACE_GROWTH`) and their columns, and its drive periods × modes.
+    ///
+    /// # Errors
+    /// As [`SimulateRequest::validate_in_memory`].
+    pub fn in_memory_cost(&self, params: &Params) -> Result<Cost, SimError> {
+        use super::costs::{recorded_sample_bytes, MODEL_BYTES, TRACE_GROWTH};
+        let span = self.validate_in_memory(params)?;
+        let columns = (7 + params.state_dim()) as f64 * 8.0;
+        Ok(Cost {
+            bytes: MODEL_BYTES
+                + span.rows * (TRACE_GROWTH * recorded_sample_bytes(params) + columns),
+            work: span.total_periods * params.modes as f64,
+        })
+    }
 }

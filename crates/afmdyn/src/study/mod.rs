@@ -317,6 +317,10 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
     let count = AtomicUsize::new(0);
     let shared = Mutex::new((&mut *store, None::<CheckpointError>));
     let sink = |record: S::Record| {
+        // nothing is stored after a cancel: a task it cut short may end as a failed record
+        if cancel.load(Ordering::Relaxed) {
+            return;
+        }
         let units = study.record_units(&record);
         let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
         let (s, failed) = &mut *guard;
@@ -332,7 +336,10 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
         drop(guard);
         observer.stored(units, count.fetch_add(1, Ordering::SeqCst) + 1);
     };
-    let ran = crate::study::in_pool(threads, || study.run(&done, &sink, cancel));
+    let watched = crate::error::watched();
+    let ran = crate::study::in_pool(threads, || {
+        crate::error::watching(watched, || study.run(&done, &sink, cancel))
+    });
     let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
     if let Some(e) = failed {
         return Err(e.into());

@@ -51,7 +51,7 @@ impl NamedRequest {
     /// As `crate::request::run()`.
     pub fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
         each_request!(&self.0, r => door(r, model, progress),
-            Simulate(s) => simulate(s, model),
+            Simulate(s) => progress.watch(|| simulate(s, model)),
             ReconstructDocument(f) => reconstruct_document(f, model, progress))
     }
 }

@@ -89,13 +89,21 @@ impl PeakForceStudy {
             .rev()
             .find_map(|r| r.tap.as_ref().map(|t| t.state.clone()))
             .unwrap_or_else(|| DVector::zeros(dim));
+        // only the first computed tap's cycle is shown: the others' are dropped as they come,
+        // so that a sweep holds one cycle of `samples`, not one per value (issue 77 §1: 10⁴
+        // values of 10⁶ samples grew past 24 GB)
+        let mut shown = done.iter().any(|r| r.tap.is_some());
         for i in done.len()..self.points.len() {
             if cancel.load(Ordering::Relaxed) {
                 return Err(SimError::Cancelled);
             }
             let record = match self.tap(i, &start) {
-                Ok((params, tap, evaluations)) => {
+                Ok((params, mut tap, evaluations)) => {
                     start.copy_from(&tap.state);
+                    if shown {
+                        tap.cycle = Cycle::default();
+                    }
+                    shown = true;
                     SweepTap {
                         index: i,
                         params,
