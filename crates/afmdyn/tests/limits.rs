@@ -220,6 +220,19 @@ mod costs {
         let text = e.to_string();
         assert!(text.starts_with(a.name()), "{text}");
         assert!(text.contains(budget), "{text}");
+        // the fields that drive the cost, and the size that would fit (issue 77 item 1)
+        assert!(text.contains(a.cost_advice()), "{text}");
+        let cost = a.cost(m).expect("cost");
+        // the memory is checked first
+        let over = match cost.bytes / afmdyn::request::limits::MAX_REQUEST_BYTES {
+            m if m > 1.0 => m,
+            _ => cost.work / afmdyn::request::limits::MAX_REQUEST_WORK,
+        };
+        let fits = format!("{:.0} % of this size fits", 100.0 / over);
+        assert!(
+            over < 10.0 && text.contains(&fits) || over >= 10.0,
+            "{text}: {fits}"
+        );
         assert_eq!(progress.done(), 0, "{}: refused before any work", a.name());
     }
 

@@ -596,6 +596,9 @@ impl Request for BifurcationRequest {
 }
 
 impl Request for GlobalContinuationRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer steps or samples (random starts), or a shorter transient (max_periods)"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
     }
@@ -615,6 +618,9 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 mod tests;
 
 impl Request for OrbitRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for a shorter transient (max_periods) or a lower max_period"
+    }
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         OrbitRequest::validate(self)
     }
@@ -635,6 +641,9 @@ impl Request for OrbitRequest {
 }
 
 impl Request for ContinuationRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for a shorter range (from, to) or a shorter transient (max_periods)"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         ContinuationRequest::validate(self, &model.params)
     }
@@ -663,6 +672,9 @@ impl Request for ContinuationRequest {
 }
 
 impl Request for LyapunovRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer periods or a shorter transient"
+    }
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         LyapunovRequest::validate(self)
     }
@@ -686,6 +698,9 @@ impl Request for LyapunovRequest {
 }
 
 impl Request for AttractorsRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer samples (random starts) or a shorter transient (max_periods)"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
     }
@@ -699,6 +714,9 @@ impl Request for AttractorsRequest {
 }
 
 impl Request for ObserveRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer periods or harmonics, or a shorter transient (max_periods)"
+    }
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ObserveRequest::validate(self)
     }
@@ -723,6 +741,9 @@ impl Request for ObserveRequest {
 }
 
 impl Request for ConvergeRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer max_modes, periods or samples_per_period"
+    }
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ConvergeRequest::validate(self)
     }

@@ -73,11 +73,26 @@ pub(crate) fn check_cost_advising(
     work_hint: &'static str,
 ) -> Result<(), SimError> {
     const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+    // the size that would fit, for a cost that grows with the request's size
+    let fits = |over: f64| {
+        let percent = 100.0 / over;
+        match percent {
+            p if !p.is_finite() || p <= 0.0 => String::new(),
+            p if p >= 10.0 => format!(" (about {p:.0} % of this size fits)"),
+            p if p >= 1.0 => format!(" (about {p:.1} % of this size fits)"),
+            p if p >= 0.01 => format!(" (about {p:.2} % of this size fits)"),
+            p => format!(" (about {p:.1e} % of this size fits)"),
+        }
+    };
     // NaN (an estimate that overflowed) is refused too
     if cost.bytes.is_nan() || cost.bytes > MAX_REQUEST_BYTES {
         return Err(SimError::Budget {
             what,
-            needed: format!("a peak memory of {:.2} GiB", cost.bytes / GIB),
+            needed: format!(
+                "a peak memory of {:.2} GiB{}",
+                cost.bytes / GIB,
+                fits(cost.bytes / MAX_REQUEST_BYTES)
+            ),
             budget: format!("{:.1} GiB", MAX_REQUEST_BYTES / GIB),
             hint: memory_hint,
         });
@@ -86,8 +101,9 @@ pub(crate) fn check_cost_advising(
         return Err(SimError::Budget {
             what,
             needed: format!(
-                "{:.3e} mode-periods (drive periods integrated × modes)",
-                cost.work
+                "{:.3e} mode-periods (drive periods integrated × modes){}",
+                cost.work,
+                fits(cost.work / MAX_REQUEST_WORK)
             ),
             budget: format!("{MAX_REQUEST_WORK:.0e} mode-periods"),
             hint: work_hint,

@@ -20,7 +20,7 @@
 //! counts) and stop with [`SimError::Cancelled`] when it is cancelled. `modes`, `orbit` and
 //! `observe` are one short computation each and neither count nor check it.
 
-use super::costs::{check_cost, stepped_cost};
+use super::costs::{check_cost_advising, stepped_cost};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
 use crate::analysis::progress::Progress;
@@ -86,6 +86,11 @@ pub trait Request {
     /// # Errors
     /// As the analysis' validation.
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError>;
+    /// What a refusal over the budget advises: the fields whose size drives the cost
+    /// ([`Request::cost`]), named as the request names them.
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer points, samples, cells or periods, or a shorter transient (max_periods)"
+    }
     /// The parameters the result was computed at, for the SI block: `model.params`, unless
     /// the analysis moves them (a resonance curve under a probe is the free resonance,
     /// `super::curves::free_resonance_base`).
@@ -190,13 +195,15 @@ pub fn run_admitted<A: Analysis + ?Sized>(
     progress: &Progress,
 ) -> Result<Document<A::Output>, SimError> {
     progress.check()?;
-    let output = progress.watch(|| analysis.execute(model, progress))?;
+    // the document too: a report may refine what it lists (a setpoint's operating points)
+    let (output, json) = progress.watch(|| {
+        let output = analysis.execute(model, progress)?;
+        let json = document(analysis, model, &output)?;
+        Ok::<_, SimError>((output, json))
+    })?;
     // a run cancelled midway may have turned the cancel into failed parts: never a result
     progress.check()?;
-    Ok(Document {
-        json: document(analysis, model, &output)?,
-        output,
-    })
+    Ok(Document { json, output })
 }
 
 /// Admit `analysis` on `model` before any work: [`Request::validate`], then its
@@ -208,7 +215,8 @@ pub fn run_admitted<A: Analysis + ?Sized>(
 /// validation errors; [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(), SimError> {
     validate(analysis, model)?;
-    check_cost(analysis.name(), analysis.cost(model)?)
+    let advice = analysis.cost_advice();
+    check_cost_advising(analysis.name(), analysis.cost(model)?, advice, advice)
 }
 
 /// [`admit`] without the cost: the probe held against what the request uses of it
@@ -376,6 +384,9 @@ impl ResonanceRequest {
 pub struct Bimodal(pub ApproachRequest);
 
 impl Request for ApproachRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer points or trace samples (traces), or branches = false"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -391,6 +402,9 @@ impl Request for ApproachRequest {
 }
 
 impl Request for ResonanceRequest {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer points or trace samples (traces), or branches = false"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -406,6 +420,9 @@ impl Request for ResonanceRequest {
 }
 
 impl Request for Bimodal {
+    fn cost_advice(&self) -> &'static str {
+        "ask for fewer points or trace samples (traces), or branches = false"
+    }
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         crate::request::curves::check_bimodal(&model.params)?;
         self.0.validate(model)
