@@ -322,3 +322,78 @@ fn the_grazing_warning_of_a_fit_gives_advice() {
         "{w}"
     );
 }
+
+/// Issue 77 item 4: data written in other units than SI are named with their likely unit, and
+/// a contact point fitted far outside the heights says the fit did not find the contact — a
+/// force curve in nN read as N (its contact point was fitted at metres), and one in nm read as
+/// m; the curve in SI has neither warning.
+#[test]
+fn unit_slips_in_a_force_curve_are_named() {
+    let (height, force) = synthetic(400, 0.0, 1);
+    let warnings = |h: Vec<f64>, f: Vec<f64>| -> Vec<String> {
+        let r = request(h, f, &["sample.youngs_modulus", "contact_point"]);
+        let r = FitRequest {
+            profiles: Some(false),
+            ..r
+        };
+        run(&r, &probe(), &Progress::default()).unwrap().json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap().to_string())
+            .collect()
+    };
+    let clean = warnings(height.clone(), force.clone());
+    assert!(
+        !clean
+            .iter()
+            .any(|w| w.contains("written in") || w.contains("contact_point =")),
+        "{clean:?}"
+    );
+    let nano_newtons: Vec<f64> = force.iter().map(|f| f * 1e9).collect();
+    let w = warnings(height.clone(), nano_newtons);
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("force: ") && w.contains("written in nN?")),
+        "{w:?}"
+    );
+    let nanometres: Vec<f64> = height.iter().map(|h| h * 1e9).collect();
+    let w = warnings(nanometres, force);
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("height: ") && w.contains("written in nm?")),
+        "{w:?}"
+    );
+}
+
+/// Issue 77 item 4: an AM curve's amplitudes written in nm (as metres they were fitted with
+/// exit 0, a Hamaker interval of ±1.47 J) are named against the probe's free amplitude A₀ with
+/// their likely unit, and an FM curve's shifts written in kHz against f₀; the columns in SI
+/// have no such warning.
+#[test]
+fn unit_slips_in_a_dynamic_curve_are_named() {
+    use afmdyn::request::fit_result::AmData;
+    let (a0, f0): (f64, f64) = (10e-9, 300e3);
+    let z: Vec<f64> = (0..50).map(|i| 11e-9 - 0.16e-9 * i as f64).collect();
+    let amplitude: Vec<f64> = z.iter().map(|z| a0.min(*z)).collect();
+    let shift: Vec<f64> = z.iter().map(|z| -30.0 * (3e-9 / z).powi(2)).collect();
+    let data = |amplitude: &[f64], shift: Option<&[f64]>| AmData {
+        z: z.clone(),
+        amplitude: Some(amplitude.to_vec()),
+        frequency_shift: shift.map(<[f64]>::to_vec),
+        ..AmData::default()
+    };
+    assert!(data(&amplitude, Some(&shift)).unit_slips(a0, f0).is_empty());
+    let nm: Vec<f64> = amplitude.iter().map(|a| a * 1e9).collect();
+    let w = data(&nm, None).unit_slips(a0, f0);
+    assert!(
+        w.len() == 1 && w[0].starts_with("amplitude: ") && w[0].contains("written in nm?"),
+        "{w:?}"
+    );
+    let khz: Vec<f64> = shift.iter().map(|f| f / 1e3).collect();
+    let w = data(&amplitude, Some(&khz)).unit_slips(a0, f0);
+    assert!(
+        w.len() == 1 && w[0].starts_with("frequency_shift: ") && w[0].contains("in kHz?"),
+        "{w:?}"
+    );
+}

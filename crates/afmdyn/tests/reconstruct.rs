@@ -371,3 +371,41 @@ fn noisy_data_measured() {
         }
     }
 }
+
+/// Issue 77 item 4: a frequency-shift curve's distances written in nm, or its shifts in kHz,
+/// are named with their likely unit; the curve in SI has no such warning.
+#[test]
+fn unit_slips_in_a_shift_curve_are_named() {
+    use afmdyn::request::reconstruct::ReconstructRequest;
+    // from 3 nm: a shift of tens of Hz, which in kHz reads as below any a lever measures
+    let distance: Vec<f64> = (0..200).map(|i| 3e-9 + 0.05e-9 * i as f64).collect();
+    let c = curve(distance, 1e-9);
+    let request = |d: &[f64], s: &[f64]| ReconstructRequest {
+        distance: Some(d.to_vec()),
+        frequency_shift: s.to_vec(),
+        spring_constant: K,
+        resonance_frequency: F0,
+        amplitude: 1e-9,
+        ..ReconstructRequest::default()
+    };
+    let slips = |r: ReconstructRequest| -> Vec<String> {
+        r.warnings()
+            .into_iter()
+            .filter(|w| w.contains("written in"))
+            .collect()
+    };
+    assert!(slips(request(&c.distance, &c.frequency_shift)).is_empty());
+    let nm: Vec<f64> = c.distance.iter().map(|d| d * 1e9).collect();
+    let w = slips(request(&nm, &c.frequency_shift));
+    assert!(
+        w.len() == 1 && w[0].starts_with("distance: ") && w[0].contains("written in nm?"),
+        "{w:?}"
+    );
+    let khz: Vec<f64> = c.frequency_shift.iter().map(|f| f / 1e3).collect();
+    let largest = khz.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let w = slips(request(&c.distance, &khz));
+    assert!(
+        w.len() == 1 && w[0].starts_with("frequency_shift: ") && w[0].contains("in kHz?"),
+        "{w:?} (largest {largest})"
+    );
+}

@@ -75,6 +75,71 @@ const UNITS: [(&str, i32, Dim); 15] = [
     ("N", 0, Dim::Force),
 ];
 
+/// A data column checked against the probe (issue 77 item 4): `magnitude`, a positive size of
+/// the column (its span, or its largest |value|), against the `typical` range (lo, hi) in SI
+/// that the probe gives it; outside, the warning names the column, the range and the unit the
+/// data were likely written in (the one of `dim` that brings `magnitude` into the range), for
+/// data are read in SI. `None` within the range, or for no magnitude (an empty or constant
+/// column).
+pub(crate) fn unit_slip(
+    column: &str,
+    what: &str,
+    magnitude: f64,
+    dim: Dim,
+    typical: (f64, f64),
+) -> Option<String> {
+    let (lo, hi) = typical;
+    if !(magnitude.is_finite() && magnitude > 0.0) || (lo..=hi).contains(&magnitude) {
+        return None;
+    }
+    let unit = dim.unit();
+    // of the units that bring it into the range, the one nearest the range's middle (in
+    // decades)
+    let middle = (lo * hi).sqrt();
+    let likely = UNITS
+        .iter()
+        .filter(|(name, p, d)| *d == dim && *p != 0 && *name != "um")
+        .filter(|(_, p, _)| (lo..=hi).contains(&(magnitude * 10f64.powi(*p))))
+        .min_by(|a, b| {
+            let off = |p: i32| (magnitude * 10f64.powi(p) / middle).log10().abs();
+            off(a.1).total_cmp(&off(b.1))
+        })
+        .map_or_else(
+            || "; check its unit".to_string(),
+            |(name, p, _)| {
+                format!(
+                    ": written in {name}? (in {name} it would be {:.3e} {unit}; data are read in \
+                     SI, {unit})",
+                    magnitude * 10f64.powi(*p)
+                )
+            },
+        );
+    Some(format!(
+        "{column}: {what} is {magnitude:.3e} {unit}, outside the {lo:.0e}..{hi:.0e} {unit} this \
+         probe's data take{likely}"
+    ))
+}
+
+/// The span max − min of the finite values of `v` (0 for fewer than two).
+pub(crate) fn span(v: &[f64]) -> f64 {
+    let finite = v.iter().copied().filter(|x| x.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    if hi > lo {
+        hi - lo
+    } else {
+        0.0
+    }
+}
+
+/// The largest |value| of the finite values of `v` (0 for none).
+pub(crate) fn largest_magnitude(v: &[f64]) -> f64 {
+    v.iter()
+        .filter(|x| x.is_finite())
+        .fold(0.0, |m: f64, x| m.max(x.abs()))
+}
+
 impl std::str::FromStr for Quantity {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
@@ -148,6 +213,32 @@ impl Quantity {
 
 #[cfg(test)]
 mod tests {
+    /// The likely unit of a slip is the one that brings the column nearest the middle of its
+    /// range; within the range, or for an empty column, nothing is said.
+    #[test]
+    fn a_unit_slip_names_the_likely_unit() {
+        use super::{unit_slip, Dim};
+        let w = unit_slip("height", "the span", 3230.0, Dim::Length, (1e-9, 1e-4)).unwrap();
+        assert!(
+            w.contains("written in nm?") && w.contains("3.230e-6 m"),
+            "{w}"
+        );
+        let w = unit_slip("force", "the span", 36.6, Dim::Force, (2e-11, 2e-6)).unwrap();
+        assert!(w.contains("written in nN?"), "{w}");
+        let w = unit_slip(
+            "frequency_shift",
+            "the largest",
+            0.08,
+            Dim::Frequency,
+            (0.3, 1.5e5),
+        );
+        assert!(w.unwrap().contains("written in kHz?"));
+        assert!(unit_slip("height", "the span", 2e-6, Dim::Length, (1e-9, 1e-4)).is_none());
+        assert!(unit_slip("height", "the span", 0.0, Dim::Length, (1e-9, 1e-4)).is_none());
+        let w = unit_slip("force", "the span", 1e30, Dim::Force, (2e-11, 2e-6)).unwrap();
+        assert!(w.ends_with("check its unit"), "{w}");
+    }
+
     use super::{Dim, Quantity};
 
     #[test]

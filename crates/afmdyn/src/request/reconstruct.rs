@@ -116,6 +116,32 @@ fn range_of(section: &str, key: &str) -> &'static crate::probe::ranges::SiRange 
 /// warning: the inversion integrates Δf beyond each distance and stops at the data's end.
 pub(crate) const DECAYED: f64 = 0.01;
 
+/// A frequency-shift curve's columns held against the probe (issue 77 item 4): the distances'
+/// span against the range of a tip–sample distance (10 pm to 10 µm), the largest |Δf|
+/// against the resonance f₀ (from 10⁻⁶ f₀ to half of it).
+pub(crate) fn shift_curve_slips(distance: &[f64], shift: &[f64], f0: f64) -> Vec<String> {
+    use super::quantity::{largest_magnitude, span, unit_slip, Dim};
+    [
+        unit_slip(
+            "distance",
+            "the span",
+            span(distance),
+            Dim::Length,
+            (1e-11, 1e-5),
+        ),
+        unit_slip(
+            "frequency_shift",
+            "the largest |Δf|",
+            largest_magnitude(shift),
+            Dim::Frequency,
+            (1e-6 * f0, 0.5 * f0),
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
 impl ReconstructRequest {
     /// The curve to invert, in increasing distance.
     ///
@@ -195,6 +221,11 @@ impl ReconstructRequest {
             })
             .collect();
         if let Ok(c) = self.curve() {
+            warnings.extend(shift_curve_slips(
+                &c.distance,
+                &c.frequency_shift,
+                c.resonance_frequency,
+            ));
             let n = c.distance.len();
             let far = c.frequency_shift[n - 1];
             let (at, extreme) = c

@@ -162,6 +162,44 @@ fn sls_start_warning(model: &SlsCurveModel, p: &[f64]) -> Option<String> {
     })
 }
 
+/// A force curve's columns held against the probe (issue 77 item 4): the heights' span
+/// against a piezo's travel (1 nm to 100 µm), the forces' span against what the lever's
+/// deflection over that span allows (k × the heights' span, from 10⁻⁴ of it on a soft sample
+/// to 10 times it).
+fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String> {
+    use crate::request::quantity::{span, unit_slip, Dim};
+    let h = span(height);
+    let slips = [
+        unit_slip("height", "the span", h, Dim::Length, (1e-9, 1e-4)),
+        unit_slip(
+            "force",
+            "the span",
+            span(force),
+            Dim::Force,
+            (1e-4 * k * h, 10.0 * k * h),
+        ),
+    ];
+    slips.into_iter().flatten().collect()
+}
+
+/// A contact point fitted more than the heights' span outside them: the fit has not found the
+/// contact (issue 77 item 4: a curve in nm and nN gave −1445 m).
+fn contact_point_warning(height: &[f64], contact: f64) -> Option<String> {
+    let h = crate::request::quantity::span(height);
+    let (lo, hi) = height
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(*x), hi.max(*x))
+        });
+    (contact < lo - h || contact > hi + h).then(|| {
+        format!(
+            "contact_point = {contact:.4e} m lies far outside the heights measured ({lo:.4e} to \
+             {hi:.4e} m): the fit has not found the contact; check the columns' units and the \
+             curve's segment"
+        )
+    })
+}
+
 impl Analysis for FitRequest {
     type Output = FitResult;
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
@@ -243,6 +281,11 @@ impl Analysis for FitRequest {
                 .warnings
                 .extend(sls_start_warning(model, &outcome.values));
         }
+        outcome.warnings.extend(data_warnings(&height, &force, k));
+        let contact = names.iter().position(|n| *n == CONTACT_POINT);
+        outcome
+            .warnings
+            .extend(contact.and_then(|i| contact_point_warning(&height, outcome.values[i])));
         Ok(FitResult {
             law,
             spring_constant: k,

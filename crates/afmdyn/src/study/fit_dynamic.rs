@@ -100,6 +100,9 @@ pub(crate) fn execute(
     let mut outcome = fit_cancellable(curve.curve(), &obs, &params, &fixed, walk, progress)?;
     let model_warnings = curve.warnings();
     outcome.warnings.extend(model_warnings.iter().cloned());
+    outcome
+        .warnings
+        .extend(data.unit_slips(probe.free_amplitude, probe.calibration.resonance_frequency));
     if fm && (data.amplitude.is_some() || data.phase.is_some()) {
         outcome.warnings.push(
             "the data have a frequency_shift column: fitted as an FM curve (the loop holds the \
