@@ -130,7 +130,7 @@ pub struct FitFlags {
     #[arg(long, value_parser = ["approach", "retract", "whole"], help = "The segment fitted: approach, retract or whole; default the approach, the whole curve for the sls law.")]
     pub segment: Option<String>,
     /// `--range`: the request's `range`.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "LO,HI", help = "The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as nanite's range_x); default the whole segment. With --probe a unit may follow (20nm).")]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "LO,HI", help = "The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as nanite's range_x; on a dynamic curve, of its piezo positions z); default the whole segment. With --probe a unit may follow (20nm).")]
     pub range: Option<Vec<Quantity>>,
     /// `--approach-rows`: the request's `approach_rows`.
     #[arg(long, value_name = "N", help = "The number of rows of the approach (the rest is the retract), as an instrument records its segments (afmformats' segment column, which Python reads from an instrument file); default up to the lowest piezo height, inclusive. 1 to the number of rows.")]

@@ -397,3 +397,55 @@ fn unit_slips_in_a_dynamic_curve_are_named() {
         "{w:?}"
     );
 }
+
+/// Issue 77 item 5, one reader of columns: a column named twice is refused naming it, a
+/// non-finite cell naming its column and row, a curve with no approach without speaking of a
+/// `range` nobody gave; `range` applies to a dynamic curve's z (it was ignored there).
+#[test]
+fn the_columns_are_read_one_way() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-columns-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let twice = dir.join("twice.csv");
+    std::fs::write(&twice, "height,force,force\n1e-7,1e-9,1e-9\n").unwrap();
+    let r = FitRequest {
+        data: Some(twice.display().to_string()),
+        ..FitRequest::default()
+    };
+    let e = run(&r, &probe(), &Progress::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the column \"force\" appears twice (columns 2 and 3)"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+
+    let (height, mut force) = synthetic(100, 0.0, 1);
+    force[4] = f64::NAN;
+    let e = run(
+        &request(height, force, &["contact_point"]),
+        &probe(),
+        &Progress::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("force = row 5: NaN"), "{e}");
+
+    let flat = request(vec![1e-7; 20], vec![1e-9; 20], &["contact_point"]);
+    let e = run(&flat, &probe(), &Progress::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("segment = ") && !e.contains("range"), "{e}");
+
+    use afmdyn::request::fit_result::AmData;
+    let data = AmData {
+        z: vec![1e-9, 2e-9, 3e-9, 4e-9],
+        amplitude: Some(vec![1.0, 2.0, 3.0, 4.0]),
+        ..AmData::default()
+    }
+    .within([1.5e-9, 3.5e-9]);
+    assert_eq!(
+        (data.z, data.amplitude),
+        (vec![2e-9, 3e-9], Some(vec![2.0, 3.0]))
+    );
+}

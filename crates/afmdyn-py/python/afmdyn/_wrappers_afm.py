@@ -800,7 +800,8 @@ def fit(
             standard error, at most 6 refits, each started from its neighbour; a side that
             has not risen by then is reported flat).
         fit_range: The range of tip positions fitted [lo, hi] (m, after the preprocessing's
-            offset, as nanite's ``range_x``); default the whole segment.
+            offset, as nanite's ``range_x``; on a dynamic curve, of its piezo positions z);
+            default the whole segment.
         segment: The segment fitted: ``approach``, ``retract`` or ``whole``; default the
             approach, the whole curve for the ``sls`` law.
         curve: which curve of an afmformats file with several (a force map), from 0.

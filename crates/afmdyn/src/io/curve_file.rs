@@ -89,6 +89,19 @@ fn read_columns(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), InputFileEr
         .iter()
         .map(|h| h.trim().to_string())
         .collect();
+    // a name twice would leave which of its columns is read to the reader's order
+    for (k, name) in names.iter().enumerate() {
+        if let Some(j) = names[..k].iter().position(|n| n == name) {
+            return Err(invalid(
+                path,
+                format!(
+                    "the column {name:?} appears twice (columns {} and {}): name each once",
+                    j + 1,
+                    k + 1
+                ),
+            ));
+        }
+    }
     let mut columns = vec![Vec::new(); names.len()];
     for (line, record) in reader.records().enumerate() {
         let record = record.map_err(csv_error)?;

@@ -77,7 +77,8 @@ pub struct FitRequest {
     /// curve for the `sls` law.
     pub segment: Option<FitSegment>,
     /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
-    /// nanite's `range_x`); default the whole segment.
+    /// nanite's `range_x`; on a dynamic curve, of its piezo positions z); default the whole
+    /// segment.
     #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub range: Option<[f64; 2]>,
     /// The number of rows of the approach (the rest is the retract), as an instrument records
@@ -262,15 +263,7 @@ impl FitRequest {
                 return Err(bad("fit", f, "named twice".into()));
             }
         }
-        if let Some([lo, hi]) = self.range {
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(bad(
-                    "range",
-                    format!("[{lo}, {hi}]"),
-                    "must be two finite tip positions lo < hi (m)".into(),
-                ));
-            }
-        }
+        self.check_range()?;
         if self.data.is_none() {
             // (the times matter, and are checked, for the sls law only)
             let time =
@@ -278,6 +271,23 @@ impl FitRequest {
             check_columns(&self.height, &self.force, self.sigma.as_deref(), time)?;
         }
         Ok(law)
+    }
+}
+
+impl FitRequest {
+    /// `range`, when given, is two finite positions lo < hi.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `range`.
+    fn check_range(&self) -> Result<(), SimError> {
+        match self.range {
+            Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => Err(bad(
+                "range",
+                format!("[{lo}, {hi}]"),
+                "must be two finite positions lo < hi (m)".into(),
+            )),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -309,12 +319,14 @@ pub(crate) fn check_columns(
             format!("a force curve has {MIN_FIT_ROWS}..={MAX_FIT_ROWS} rows"),
         ));
     }
-    if let Some(i) = height.iter().chain(force).position(|x| !x.is_finite()) {
-        return Err(bad(
-            "data",
-            format!("row {}", i % force.len() + 1),
-            "heights and forces must be finite".into(),
-        ));
+    for (name, column) in [("height", height), ("force", force)] {
+        if let Some(i) = column.iter().position(|x| !x.is_finite()) {
+            return Err(bad(
+                name,
+                format!("row {}: {}", i + 1, column[i]),
+                "every value must be finite".into(),
+            ));
+        }
     }
     if let Some(i) = sigma.and_then(|s| s.iter().position(|x| !(x.is_finite() && *x > 0.0))) {
         return Err(bad(
@@ -346,7 +358,7 @@ impl Request for FitRequest {
             if let Some(p) = model.probe.as_ref().filter(|p| !p.assumed.is_empty()) {
                 super::fit_dynamic::am_probe(p)?;
             }
-            return Ok(());
+            return self.check_range();
         }
         self.check(model).map(|_| ())
     }

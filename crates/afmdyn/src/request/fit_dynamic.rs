@@ -87,38 +87,28 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             format!("a dynamic curve has {MIN_FIT_ROWS}..=100000 rows"),
         ));
     }
-    let all = [
-        &Some(d.z.clone()),
-        &d.amplitude,
-        &d.phase,
-        &d.sigma_amplitude,
-        &d.sigma_phase,
-        &d.frequency_shift,
-        &d.sigma_frequency_shift,
-        &d.amplitude_2,
-        &d.phase_2,
-        &d.sigma_amplitude_2,
-        &d.sigma_phase_2,
-    ];
-    for c in all.into_iter().flatten() {
-        if c.len() != m || c.iter().any(|x| !x.is_finite()) {
+    for (name, c) in d.named() {
+        if c.len() != m {
             return Err(bad(
-                "data",
-                "a column",
-                "every column must have one finite value per row".into(),
+                name,
+                format!("{} rows", c.len()),
+                format!("every column must have one value per row ({m} values of z)"),
             ));
         }
-    }
-    let sigmas = [
-        &d.sigma_amplitude,
-        &d.sigma_phase,
-        &d.sigma_frequency_shift,
-        &d.sigma_amplitude_2,
-        &d.sigma_phase_2,
-    ];
-    for s in sigmas.into_iter().flatten() {
-        if s.iter().any(|x| *x <= 0.0) {
-            return Err(bad("sigma", "≤ 0", "σ must be > 0".into()));
+        if let Some(i) = c.iter().position(|x| !x.is_finite()) {
+            return Err(bad(
+                name,
+                format!("row {}: {}", i + 1, c[i]),
+                "every value must be finite".into(),
+            ));
+        }
+        let sigma = name.starts_with("sigma_");
+        if let Some(i) = c.iter().position(|x| sigma && *x <= 0.0) {
+            return Err(bad(
+                name,
+                format!("row {}: {}", i + 1, c[i]),
+                "a standard deviation must be > 0".into(),
+            ));
         }
     }
     if bimodal && d.frequency_shift.is_some() {

@@ -18,6 +18,53 @@ pub(crate) fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
 }
 
 impl AmData {
+    /// Its columns present, by their names in a data file.
+    pub(crate) fn named(&self) -> Vec<(&'static str, &[f64])> {
+        let optional = [
+            ("amplitude", &self.amplitude),
+            ("phase", &self.phase),
+            ("sigma_amplitude", &self.sigma_amplitude),
+            ("sigma_phase", &self.sigma_phase),
+            ("frequency_shift", &self.frequency_shift),
+            ("sigma_frequency_shift", &self.sigma_frequency_shift),
+            ("amplitude_2", &self.amplitude_2),
+            ("phase_2", &self.phase_2),
+            ("sigma_amplitude_2", &self.sigma_amplitude_2),
+            ("sigma_phase_2", &self.sigma_phase_2),
+        ];
+        std::iter::once(("z", self.z.as_slice()))
+            .chain(
+                optional
+                    .into_iter()
+                    .filter_map(|(n, c)| Some((n, c.as_deref()?))),
+            )
+            .collect()
+    }
+    /// The rows whose piezo position z lies in `range` [lo, hi] (m), every column kept alike
+    /// (`FitRequest::range` on a dynamic curve).
+    pub(crate) fn within(self, [lo, hi]: [f64; 2]) -> AmData {
+        let keep: Vec<bool> = self.z.iter().map(|z| (lo..=hi).contains(z)).collect();
+        let rows = |c: Vec<f64>| -> Vec<f64> {
+            c.into_iter()
+                .zip(&keep)
+                .filter_map(|(v, k)| k.then_some(v))
+                .collect()
+        };
+        let some = |c: Option<Vec<f64>>| c.map(rows);
+        AmData {
+            z: rows(self.z),
+            amplitude: some(self.amplitude),
+            phase: some(self.phase),
+            sigma_amplitude: some(self.sigma_amplitude),
+            sigma_phase: some(self.sigma_phase),
+            frequency_shift: some(self.frequency_shift),
+            sigma_frequency_shift: some(self.sigma_frequency_shift),
+            amplitude_2: some(self.amplitude_2),
+            phase_2: some(self.phase_2),
+            sigma_amplitude_2: some(self.sigma_amplitude_2),
+            sigma_phase_2: some(self.sigma_phase_2),
+        }
+    }
     /// Its columns held against the probe (issue 77 item 4): the piezo positions' span
     /// against an approach's (10 pm to 100 µm), the largest amplitude against the free
     /// amplitude `a0` (10⁻³ to 3 times it), the largest |Δf| against the resonance `f0`

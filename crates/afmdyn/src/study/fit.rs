@@ -80,17 +80,20 @@ fn fit_rows(
 ) -> Result<Vec<usize>, SimError> {
     let rows = curve.rows(segment, range);
     if rows.len() < MIN_FIT_ROWS.max(fitted + 1) {
+        let part = match segment {
+            Segment::Approach => "approach",
+            Segment::Retract => "retract",
+            Segment::Whole => "curve",
+        };
+        // the range named only where one was given (a constant-height curve has no approach)
+        let (name, where_) = match range {
+            Some(_) => ("range", " in the range"),
+            None => ("segment", ""),
+        };
         return Err(bad(
-            "range",
+            name,
             format!("{} rows", rows.len()),
-            format!(
-                "too few rows of the {} in the range to fit {fitted} parameters",
-                match segment {
-                    Segment::Approach => "approach",
-                    Segment::Retract => "retract",
-                    Segment::Whole => "curve",
-                },
-            ),
+            format!("too few rows of the {part}{where_} to fit {fitted} parameters"),
         ));
     }
     Ok(rows)
@@ -204,6 +207,11 @@ impl Analysis for FitRequest {
     type Output = FitResult;
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
         if let Some(data) = crate::request::fit_dynamic::read_am_data(self.data.as_deref())? {
+            // `range` of a dynamic curve: the piezo positions z fitted
+            let data = match self.range {
+                Some(range) => data.within(range),
+                None => data,
+            };
             return super::fit_dynamic::execute(
                 &self.fit,
                 self.fit == FitRequest::default().fit,
