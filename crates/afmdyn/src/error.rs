@@ -298,6 +298,17 @@ pub enum SimError {
         /// The first one's error.
         first: String,
     },
+    /// A result's document holds no finite value in any of its results (`report`'s audit of
+    /// the door): there is no answer to report.
+    #[error(
+        "{what}: no finite value in any of its results ({arrays}): there is no answer to report"
+    )]
+    NoFiniteValue {
+        /// The request.
+        what: &'static str,
+        /// The result arrays, every value of them missing.
+        arrays: String,
+    },
     /// The caller cancelled the run ([`crate::analysis::progress::Progress::cancel`]).
     #[error("cancelled")]
     Cancelled,

@@ -119,3 +119,33 @@ fn initial_modal_is_displacements_then_velocities() {
     );
     assert_eq!(report::initial_modal(None), "");
 }
+
+/// Issue 77 item 3: the door's audit of a document names every result array with missing
+/// values (NaN written as null) and how many, leaves the nulls that are a state (a
+/// nonperiodic `period`), the SI block and the messages alone, and refuses a document whose
+/// every result array is missing throughout.
+#[test]
+fn the_door_names_missing_values_and_refuses_a_document_of_none() {
+    use afmdyn::report::audit_missing;
+    use serde_json::json;
+    let mut doc = json!({
+        "curve": {"force": [1.0, null, 3.0], "distance": [1.0, 2.0, 3.0], "period": [1, null, 2]},
+        "si": {"x": [null]},
+        "message": [null, null, null],
+        "warnings": []
+    });
+    audit_missing(&mut doc, "test").unwrap();
+    let w = doc["warnings"].as_array().unwrap();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0]
+        .as_str()
+        .unwrap()
+        .starts_with("curve.force: 1 of 3 values are missing"));
+    let mut none = json!({"image": {"height": [null, null], "phase": [[null], [null]]}});
+    let e = audit_missing(&mut none, "image").unwrap_err();
+    assert!(matches!(e, afmdyn::SimError::NoFiniteValue { .. }), "{e}");
+    assert!(e.to_string().contains("image.height"), "{e}");
+    // a document of scalars only is not audited
+    let mut scalars = json!({"period": 1, "stable": true});
+    audit_missing(&mut scalars, "orbit").unwrap();
+}

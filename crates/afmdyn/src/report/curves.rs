@@ -380,6 +380,90 @@ pub(crate) fn with_si(
     doc
 }
 
+/// The keys whose `null` is a documented state, not a missing value: a nonperiodic motion's
+/// `period` and `multipliers`, a periodic one's `lyapunov`, an exponent no cell gave.
+const NULL_BY_DESIGN: [&str; 6] = [
+    "period",
+    "multipliers",
+    "lyapunov",
+    "lyapunov_error",
+    "uncertainty_exponent",
+    "event",
+];
+
+/// The door's audit of a result's document (issue 77 item 3): every array of numbers in it
+/// (outside `si`, `units`, `params`, the messages and the keys whose null is a state,
+/// [`NULL_BY_DESIGN`])
+/// with missing values — NaN or a part not computed, written as `null` — is named in a warning
+/// with how many are missing, so that no NaN is written as a value unsaid; a document whose
+/// every such array is missing throughout is no result.
+///
+/// # Errors
+/// [`crate::SimError::NoFiniteValue`] naming `what` and its arrays when none holds a number.
+pub(crate) fn audit_missing(doc: &mut Value, what: &'static str) -> Result<(), crate::SimError> {
+    fn walk(v: &Value, path: &str, found: &mut Vec<(String, usize, usize)>) {
+        match v {
+            Value::Object(m) => {
+                for (k, x) in m {
+                    let skip = ["si", "units", "params", "warnings", "scales", "message"];
+                    if !skip.contains(&k.as_str()) && !NULL_BY_DESIGN.contains(&k.as_str()) {
+                        let p = if path.is_empty() {
+                            k.clone()
+                        } else {
+                            format!("{path}.{k}")
+                        };
+                        walk(x, &p, found);
+                    }
+                }
+            }
+            Value::Array(a) => {
+                let numbers = a.iter().filter(|x| x.is_number()).count();
+                let nulls = a.iter().filter(|x| x.is_null()).count();
+                if numbers + nulls == a.len() && !a.is_empty() {
+                    found.push((path.to_string(), nulls, a.len()));
+                } else {
+                    for x in a {
+                        walk(x, &format!("{path}[]"), found);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut found = Vec::new();
+    walk(doc, "", &mut found);
+    let empty: Vec<&str> = found
+        .iter()
+        .filter(|(_, nulls, n)| nulls == n)
+        .map(|(p, _, _)| p.as_str())
+        .collect();
+    if !found.is_empty() && empty.len() == found.len() {
+        return Err(crate::SimError::NoFiniteValue {
+            what,
+            arrays: empty.join(", "),
+        });
+    }
+    let said: Vec<Value> = found
+        .iter()
+        .filter(|(_, nulls, _)| *nulls > 0)
+        .map(|(path, nulls, n)| {
+            Value::from(format!(
+                "{path}: {nulls} of {n} values are missing (null here, NaN in the tables and \
+                 arrays): those parts were not computed; the other warnings say why"
+            ))
+        })
+        .collect();
+    if !said.is_empty() && doc.is_object() {
+        if !doc["warnings"].is_array() {
+            doc["warnings"] = Value::Array(Vec::new());
+        }
+        if let Some(w) = doc["warnings"].as_array_mut() {
+            w.extend(said);
+        }
+    }
+    Ok(())
+}
+
 /// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
 /// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
 /// [`Params::rest_distance`]) and the `CURVE_COLUMNS`, plus `stable`, `period` (null when not

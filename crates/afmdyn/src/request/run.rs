@@ -259,6 +259,8 @@ pub fn document<A: Analysis + ?Sized>(
             w.extend(warnings.into_iter().map(Value::from));
         }
     }
+    // no missing value unsaid, and no document of missing values only
+    report::audit_missing(&mut doc, analysis.name())?;
     Ok(doc)
 }
 
