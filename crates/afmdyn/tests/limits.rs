@@ -221,7 +221,7 @@ mod costs {
         assert!(text.starts_with(a.name()), "{text}");
         assert!(text.contains(budget), "{text}");
         // the fields that drive the cost, and the size that would fit (issue 77 item 1)
-        assert!(text.contains(a.cost_advice()), "{text}");
+        assert!(text.contains(A::COST_ADVICE), "{text}");
         let cost = a.cost(m).expect("cost");
         // the memory is checked first
         let over = match cost.bytes / afmdyn::request::limits::MAX_REQUEST_BYTES {

@@ -582,9 +582,7 @@ impl Request for BifurcationRequest {
         let recorded = spec.steady.max_period.max(spec.steady.nonperiodic_record) as f64;
         // the transient cap at the range's ends (a model's decay, and with it the cap, moves
         // monotonically with one parameter)
-        let (lo, hi) = (spec.values.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |b, &v| {
-            (b.0.min(v), b.1.max(v))
-        });
+        let (lo, hi) = super::quantity::extent(&spec.values);
         let cap = steady_periods(&spec.steady, &p.with(spec.param, lo))?
             .max(steady_periods(&spec.steady, &p.with(spec.param, hi))?);
         let record = std::mem::size_of::<SweepRecord>() as f64 + state_bytes(p) + 64.0;
@@ -596,9 +594,8 @@ impl Request for BifurcationRequest {
 }
 
 impl Request for GlobalContinuationRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer steps or samples (random starts), or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer steps or samples (random starts), or a shorter transient (max_periods)";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
     }
@@ -618,9 +615,8 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 mod tests;
 
 impl Request for OrbitRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for a shorter transient (max_periods) or a lower max_period"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for a shorter transient (max_periods) or a lower max_period";
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         OrbitRequest::validate(self)
     }
@@ -641,9 +637,8 @@ impl Request for OrbitRequest {
 }
 
 impl Request for ContinuationRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for a shorter range (from, to) or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for a shorter range (from, to) or a shorter transient (max_periods)";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         ContinuationRequest::validate(self, &model.params)
     }
@@ -672,9 +667,7 @@ impl Request for ContinuationRequest {
 }
 
 impl Request for LyapunovRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer periods or a shorter transient"
-    }
+    const COST_ADVICE: &'static str = "ask for fewer periods or a shorter transient";
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         LyapunovRequest::validate(self)
     }
@@ -698,9 +691,8 @@ impl Request for LyapunovRequest {
 }
 
 impl Request for AttractorsRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer samples (random starts) or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer samples (random starts) or a shorter transient (max_periods)";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
     }
@@ -714,9 +706,8 @@ impl Request for AttractorsRequest {
 }
 
 impl Request for ObserveRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer periods or harmonics, or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer periods or harmonics, or a shorter transient (max_periods)";
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ObserveRequest::validate(self)
     }
@@ -741,9 +732,7 @@ impl Request for ObserveRequest {
 }
 
 impl Request for ConvergeRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer max_modes, periods or samples_per_period"
-    }
+    const COST_ADVICE: &'static str = "ask for fewer max_modes, periods or samples_per_period";
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         ConvergeRequest::validate(self)
     }

@@ -169,9 +169,8 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
 }
 
 impl Request for BasinsRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer cells (x_steps × y_steps) or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer cells (x_steps × y_steps) or a shorter transient (max_periods)";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(&model.params).map(|_| ())
     }

@@ -348,9 +348,8 @@ pub(crate) fn check_columns(
 }
 
 impl Request for FitRequest {
-    fn cost_advice(&self) -> &'static str {
-        "give fewer rows (an AM curve: fit fewer rows or parameters, or without profiles)"
-    }
+    const COST_ADVICE: &'static str =
+        "give fewer rows (an AM curve: fit fewer rows or parameters, or without profiles)";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         if super::fit_dynamic::read_am_data(self.data.as_deref())?.is_some() {
             // an AM curve: its names and columns are checked when it runs; a probe read

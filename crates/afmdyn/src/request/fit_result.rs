@@ -18,52 +18,42 @@ pub(crate) fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
 }
 
 impl AmData {
-    /// Its columns present, by their names in a data file.
-    pub(crate) fn named(&self) -> Vec<(&'static str, &[f64])> {
-        let optional = [
-            ("amplitude", &self.amplitude),
-            ("phase", &self.phase),
-            ("sigma_amplitude", &self.sigma_amplitude),
-            ("sigma_phase", &self.sigma_phase),
-            ("frequency_shift", &self.frequency_shift),
-            ("sigma_frequency_shift", &self.sigma_frequency_shift),
-            ("amplitude_2", &self.amplitude_2),
-            ("phase_2", &self.phase_2),
-            ("sigma_amplitude_2", &self.sigma_amplitude_2),
-            ("sigma_phase_2", &self.sigma_phase_2),
-        ];
-        std::iter::once(("z", self.z.as_slice()))
-            .chain(
-                optional
-                    .into_iter()
-                    .filter_map(|(n, c)| Some((n, c.as_deref()?))),
-            )
+    /// Its optional columns, by their names in a data file.
+    fn optional(&mut self) -> [(&'static str, &mut Option<Vec<f64>>); 10] {
+        [
+            ("amplitude", &mut self.amplitude),
+            ("phase", &mut self.phase),
+            ("sigma_amplitude", &mut self.sigma_amplitude),
+            ("sigma_phase", &mut self.sigma_phase),
+            ("frequency_shift", &mut self.frequency_shift),
+            ("sigma_frequency_shift", &mut self.sigma_frequency_shift),
+            ("amplitude_2", &mut self.amplitude_2),
+            ("phase_2", &mut self.phase_2),
+            ("sigma_amplitude_2", &mut self.sigma_amplitude_2),
+            ("sigma_phase_2", &mut self.sigma_phase_2),
+        ]
+    }
+    /// Its columns present (z first), by their names in a data file.
+    pub(crate) fn named(&self) -> Vec<(&'static str, Vec<f64>)> {
+        let mut d = self.clone();
+        let optional = d.optional().map(|(n, c)| c.take().map(|c| (n, c)));
+        std::iter::once(("z", self.z.clone()))
+            .chain(optional.into_iter().flatten())
             .collect()
     }
     /// The rows whose piezo position z lies in `range` [lo, hi] (m), every column kept alike
     /// (`FitRequest::range` on a dynamic curve).
-    pub(crate) fn within(self, [lo, hi]: [f64; 2]) -> AmData {
+    pub(crate) fn within(mut self, [lo, hi]: [f64; 2]) -> AmData {
         let keep: Vec<bool> = self.z.iter().map(|z| (lo..=hi).contains(z)).collect();
-        let rows = |c: Vec<f64>| -> Vec<f64> {
-            c.into_iter()
-                .zip(&keep)
-                .filter_map(|(v, k)| k.then_some(v))
-                .collect()
+        let rows = |c: &mut Vec<f64>| {
+            let mut k = keep.iter();
+            c.retain(|_| k.next() == Some(&true));
         };
-        let some = |c: Option<Vec<f64>>| c.map(rows);
-        AmData {
-            z: rows(self.z),
-            amplitude: some(self.amplitude),
-            phase: some(self.phase),
-            sigma_amplitude: some(self.sigma_amplitude),
-            sigma_phase: some(self.sigma_phase),
-            frequency_shift: some(self.frequency_shift),
-            sigma_frequency_shift: some(self.sigma_frequency_shift),
-            amplitude_2: some(self.amplitude_2),
-            phase_2: some(self.phase_2),
-            sigma_amplitude_2: some(self.sigma_amplitude_2),
-            sigma_phase_2: some(self.sigma_phase_2),
-        }
+        rows(&mut self.z);
+        self.optional()
+            .into_iter()
+            .for_each(|(_, c)| c.iter_mut().for_each(rows));
+        self
     }
     /// Its columns held against the probe (issue 77 item 4): the piezo positions' span
     /// against an approach's (10 pm to 100 µm), the largest amplitude against the free

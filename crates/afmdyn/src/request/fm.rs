@@ -229,9 +229,7 @@ impl FmRequest {
 }
 
 impl Request for FmRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer points"
-    }
+    const COST_ADVICE: &'static str = "ask for fewer points";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         super::curves::check_single_frequency(&model.params, "fm")?;
         self.spec(model).map(|_| ())

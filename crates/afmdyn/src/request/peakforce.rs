@@ -313,9 +313,7 @@ impl PeakForceRequest {
 }
 
 impl Request for PeakForceRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer samples or sweep values"
-    }
+    const COST_ADVICE: &'static str = "ask for fewer samples or sweep values";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.params(model).map(|_| ())
     }

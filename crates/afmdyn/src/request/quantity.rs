@@ -95,42 +95,34 @@ pub(crate) fn unit_slip(
     let unit = dim.unit();
     // of the units that bring it into the range, the one nearest the range's middle (in
     // decades)
-    let middle = (lo * hi).sqrt();
+    let off = |p: i32| (magnitude * 10f64.powi(p) / (lo * hi).sqrt()).log10().abs();
     let likely = UNITS
         .iter()
         .filter(|(name, p, d)| *d == dim && *p != 0 && *name != "um")
         .filter(|(_, p, _)| (lo..=hi).contains(&(magnitude * 10f64.powi(*p))))
-        .min_by(|a, b| {
-            let off = |p: i32| (magnitude * 10f64.powi(p) / middle).log10().abs();
-            off(a.1).total_cmp(&off(b.1))
-        })
-        .map_or_else(
-            || "; check its unit".to_string(),
-            |(name, p, _)| {
-                format!(
-                    ": written in {name}? (in {name} it would be {:.3e} {unit}; data are read in \
-                     SI, {unit})",
-                    magnitude * 10f64.powi(*p)
-                )
-            },
-        );
+        .min_by(|a, b| off(a.1).total_cmp(&off(b.1)))
+        .map_or("; check its unit".to_string(), |(name, p, _)| {
+            let read = magnitude * 10f64.powi(*p);
+            format!(": written in {name}? (in {name} it would be {read:.3e} {unit}; data are read in SI)")
+        });
     Some(format!(
         "{column}: {what} is {magnitude:.3e} {unit}, outside the {lo:.0e}..{hi:.0e} {unit} this \
          probe's data take{likely}"
     ))
 }
 
+/// The smallest and largest of the finite values of `v` ((∞, −∞) for none).
+pub(crate) fn extent(v: &[f64]) -> (f64, f64) {
+    let finite = v.iter().filter(|x| x.is_finite());
+    finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(*x), hi.max(*x))
+    })
+}
+
 /// The span max − min of the finite values of `v` (0 for fewer than two).
 pub(crate) fn span(v: &[f64]) -> f64 {
-    let finite = v.iter().copied().filter(|x| x.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-        (lo.min(x), hi.max(x))
-    });
-    if hi > lo {
-        hi - lo
-    } else {
-        0.0
-    }
+    let (lo, hi) = extent(v);
+    (hi - lo).max(0.0)
 }
 
 /// The largest |value| of the finite values of `v` (0 for none).

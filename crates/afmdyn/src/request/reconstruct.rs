@@ -322,9 +322,7 @@ impl ReconstructRequest {
 }
 
 impl Request for ReconstructRequest {
-    fn cost_advice(&self) -> &'static str {
-        "give fewer distances"
-    }
+    const COST_ADVICE: &'static str = "give fewer distances";
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
         let curve = self.curve()?;
         match self.inversion {

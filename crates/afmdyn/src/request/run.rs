@@ -88,9 +88,8 @@ pub trait Request {
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError>;
     /// What a refusal over the budget advises: the fields whose size drives the cost
     /// ([`Request::cost`]), named as the request names them.
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer points, samples, cells or periods, or a shorter transient (max_periods)"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer points, samples, cells or periods, or a shorter transient (max_periods)";
     /// The parameters the result was computed at, for the SI block: `model.params`, unless
     /// the analysis moves them (a resonance curve under a probe is the free resonance,
     /// `super::curves::free_resonance_base`).
@@ -215,7 +214,7 @@ pub fn run_admitted<A: Analysis + ?Sized>(
 /// validation errors; [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(), SimError> {
     validate(analysis, model)?;
-    let advice = analysis.cost_advice();
+    let advice = A::COST_ADVICE;
     check_cost_advising(analysis.name(), analysis.cost(model)?, advice, advice)
 }
 
@@ -386,9 +385,8 @@ impl ResonanceRequest {
 pub struct Bimodal(pub ApproachRequest);
 
 impl Request for ApproachRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer points or trace samples (traces), or branches = false"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer points or trace samples (traces), or branches = false";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -404,9 +402,8 @@ impl Request for ApproachRequest {
 }
 
 impl Request for ResonanceRequest {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer points or trace samples (traces), or branches = false"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer points or trace samples (traces), or branches = false";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -422,9 +419,8 @@ impl Request for ResonanceRequest {
 }
 
 impl Request for Bimodal {
-    fn cost_advice(&self) -> &'static str {
-        "ask for fewer points or trace samples (traces), or branches = false"
-    }
+    const COST_ADVICE: &'static str =
+        "ask for fewer points or trace samples (traces), or branches = false";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         crate::request::curves::check_bimodal(&model.params)?;
         self.0.validate(model)

@@ -189,11 +189,7 @@ fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String> {
 /// contact (issue 77 item 4: a curve in nm and nN gave −1445 m).
 fn contact_point_warning(height: &[f64], contact: f64) -> Option<String> {
     let h = crate::request::quantity::span(height);
-    let (lo, hi) = height
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-            (lo.min(*x), hi.max(*x))
-        });
+    let (lo, hi) = crate::request::quantity::extent(height);
     (contact < lo - h || contact > hi + h).then(|| {
         format!(
             "contact_point = {contact:.4e} m lies far outside the heights measured ({lo:.4e} to \
