@@ -208,10 +208,13 @@ pub(crate) fn census(
             },
         }
     }
-    attractors
-        .par_iter_mut()
-        .with_max_len(1)
-        .for_each(|a| polish(model, spec.integrator.clone(), a));
+    // each polish under this run's cancel flag (not a flag of the thread that runs it)
+    let watched = crate::error::watched();
+    attractors.par_iter_mut().with_max_len(1).for_each(|a| {
+        crate::error::watching(watched.clone(), || {
+            polish(model, spec.integrator.clone(), a)
+        })
+    });
     let (unsettled, attractors): (Vec<Attractor>, Vec<Attractor>) =
         merge_polished(attractors, spec.cluster_tol)
             .into_iter()

@@ -592,25 +592,29 @@ fn basin_map_of(
     }
     let cells: Vec<BasinCell> = slots.into_iter().flatten().collect();
     // polish: shooting for the periodic attractors, λ₁ for the others
+    let watched = crate::error::watched();
     let polished: Vec<(SteadyState, Option<PeriodicOrbit>, Option<f64>)> = attractors
         .into_par_iter()
         .with_max_len(1)
         .map(|mut s| {
-            let orbit = polish_steady(model, spec.integrator.clone(), &mut s);
-            let lyapunov = s
-                .period()
-                .is_none()
-                .then(|| {
-                    largest_exponent(
-                        model,
-                        s.end_state(),
-                        LYAPUNOV_PERIODS,
-                        spec.integrator.clone(),
-                    )
-                })
-                .flatten()
-                .map(|l| l.0);
-            (s, orbit, lyapunov)
+            // under this run's cancel flag (not a flag of the thread that runs it)
+            crate::error::watching(watched.clone(), || {
+                let orbit = polish_steady(model, spec.integrator.clone(), &mut s);
+                let lyapunov = s
+                    .period()
+                    .is_none()
+                    .then(|| {
+                        largest_exponent(
+                            model,
+                            s.end_state(),
+                            LYAPUNOV_PERIODS,
+                            spec.integrator.clone(),
+                        )
+                    })
+                    .flatten()
+                    .map(|l| l.0);
+                (s, orbit, lyapunov)
+            })
         })
         .collect();
     let mut map = BasinMap {
