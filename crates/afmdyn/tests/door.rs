@@ -160,8 +160,7 @@ fn peak_of<T>(f: impl FnOnce() -> T) -> (f64, T) {
 /// request's memory is its result: `converge` (every run's samples) and `approach` with traces.
 #[test]
 fn declared_memory_bounds_the_measured_peak() {
-    use afmdyn::analysis::progress::Progress;
-    use afmdyn::request::{run, ApproachRequest, ConvergeRequest, CurveRequest, Request, Resolved};
+    use afmdyn::request::{ApproachRequest, ConvergeRequest, CurveRequest, Resolved};
     let model = Resolved::plain(Params::default());
     let converge = ConvergeRequest {
         max_modes: 3,
@@ -169,13 +168,7 @@ fn declared_memory_bounds_the_measured_peak() {
         samples_per_period: 1000,
         ..ConvergeRequest::default()
     };
-    let declared = converge.cost(&model).unwrap().bytes;
-    let (peak, out) = peak_of(|| run(&converge, &model, &Progress::new()));
-    out.unwrap();
-    assert!(
-        peak <= declared && peak >= declared / 3.0,
-        "converge: peak {peak:.3e} B, declared {declared:.3e} B"
-    );
+    within_three_times(&converge, &model);
     let approach = ApproachRequest {
         curve: CurveRequest {
             points: Some(60),
@@ -185,12 +178,22 @@ fn declared_memory_bounds_the_measured_peak() {
         },
         ..ApproachRequest::default()
     };
-    let declared = approach.cost(&model).unwrap().bytes;
-    let (peak, out) = peak_of(|| run(&approach, &model, &Progress::new()));
+    within_three_times(&approach, &model);
+}
+
+/// `request`'s peak heap is at most its declared memory and at least a third of it.
+fn within_three_times<A: afmdyn::request::Analysis>(
+    request: &A,
+    model: &afmdyn::request::Resolved,
+) {
+    use afmdyn::analysis::progress::Progress;
+    let declared = request.cost(model).unwrap().bytes;
+    let (peak, out) = peak_of(|| afmdyn::request::run(request, model, &Progress::new()));
     out.unwrap();
     assert!(
         peak <= declared && peak >= declared / 3.0,
-        "approach: peak {peak:.3e} B, declared {declared:.3e} B"
+        "{}: peak {peak:.3e} B, declared {declared:.3e} B",
+        request.name()
     );
 }
 

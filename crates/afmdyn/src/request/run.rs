@@ -164,6 +164,9 @@ pub struct Presenting<'a> {
     pub to: Destination<'a>,
 }
 
+/// What a refusal of a stepped curve (approach, resonance, bimodal) advises.
+const CURVE_ADVICE: &str = "ask for fewer points or trace samples (traces), or branches = false";
+
 /// Run `analysis` on `model`: [`Request::validate`], its [`Request::cost`] held against the
 /// budgets (`check_cost`), [`Analysis::execute`], then its document with the SI block of the
 /// probe (`report::with_si`).
@@ -385,8 +388,7 @@ impl ResonanceRequest {
 pub struct Bimodal(pub ApproachRequest);
 
 impl Request for ApproachRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer points or trace samples (traces), or branches = false";
+    const COST_ADVICE: &'static str = CURVE_ADVICE;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -402,8 +404,7 @@ impl Request for ApproachRequest {
 }
 
 impl Request for ResonanceRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer points or trace samples (traces), or branches = false";
+    const COST_ADVICE: &'static str = CURVE_ADVICE;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.spec(model).map(|_| ())
     }
@@ -419,8 +420,7 @@ impl Request for ResonanceRequest {
 }
 
 impl Request for Bimodal {
-    const COST_ADVICE: &'static str =
-        "ask for fewer points or trace samples (traces), or branches = false";
+    const COST_ADVICE: &'static str = CURVE_ADVICE;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         crate::request::curves::check_bimodal(&model.params)?;
         self.0.validate(model)
