@@ -75,6 +75,8 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<errors::SimulationError>(),
     )?;
     m.add("FORCE_SIGN", afmdyn::request::FORCE_SIGN)?;
+    // the names of the one door's analyses (`door::run`), the library's registry
+    m.add("REQUEST_NAMES", afmdyn::request::named::NAMES.to_vec())?;
     m.add_function(wrap_pyfunction!(door::run, m)?)?;
     m.add_function(wrap_pyfunction!(door::run_stored, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;

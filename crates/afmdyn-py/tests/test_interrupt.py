@@ -6,11 +6,14 @@ waited for, so nothing runs on in the background."""
 from __future__ import annotations
 
 import os
+import queue
 import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -85,6 +88,159 @@ def test_ctrl_c_cancels_analyses_within_their_loops(call):
     assert code == 0, err
     assert out == ["interrupted", "after", "3"], (out, err)
     assert latency < 5, latency
+    assert "Traceback" not in err and "panicked" not in err, err
+
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+
+#: Every request kind of the library's registry (``afmdyn::request::named::NAMES``, exposed as
+#: ``afmdyn._afmdyn.REQUEST_NAMES``): the data it needs (made in the child, ``np`` and ``EX``
+#: the examples directory at hand) and its call at a size that runs for seconds (the long sizes
+#: of crates/afmdyn/tests/door.rs's ``case()``; ``p`` is the progress callback that prints
+#: "start"); ``None`` where it ends at once (door.rs gives it no long size either).
+LONG = {
+    "modes": None,
+    "simulate": ("", "afmdyn.simulate(periods=5 * 10**6, samples_per_period=1, progress=p)"),
+    # (door.rs's 10 modes and 1 sample per period end within 0.4 s at converge's Ω = 4.1)
+    "converge": ("", "afmdyn.converge(max_modes=20, periods=10000, samples_per_period=10, "
+                     "progress=p)"),
+    "attractors": ("", "afmdyn.attractors(samples=5000, progress=p)"),
+    "global_continuation": ("", "afmdyn.global_continuation(samples=64, steps=400, progress=p)"),
+    # an undamped lever far from the sample: the steady-state search runs to its cap
+    "orbit": ("", "afmdyn.orbit(beam_damping=0, gap=10, max_periods=10**7, progress=p)"),
+    # (3 modes without switch end within 0.5 s)
+    "continuation": ("", "afmdyn.continuation(from_=5.0, to=0.05, switch=True, modes=6, "
+                         "progress=p)"),
+    "lyapunov": ("", "afmdyn.lyapunov(periods=10**7, blocks=10, progress=p)"),
+    "observe": ("", "afmdyn.observe(beam_damping=0, gap=10, max_periods=10**7, progress=p)"),
+    "approach": ("", "afmdyn.approach(points=5000, progress=p)"),
+    "bimodal": ("", "afmdyn.bimodal(probe=EX + '/probe-bimodal.toml', points=5000, progress=p)"),
+    "resonance": ("", "afmdyn.resonance(points=5000, progress=p)"),
+    "basins": ("", "afmdyn.basins(x_steps=400, y_steps=400, progress=p)"),
+    "fm": ("", "afmdyn.fm(probe=EX + '/probe-point-mass-dmt.toml', points=100000, progress=p)"),
+    # an evenly spaced curve of a million distances, inverted exactly (door.rs's shift_curve)
+    "reconstruct": (
+        """
+        d = np.linspace(0.3e-9, 10e-9, 1_000_000)
+        curve = dict(distance=d, frequency_shift=-10 * (1e-9 / d) ** 1.5, spring_constant=40.0,
+                     resonance_frequency=300e3, amplitude=1e-9, inversion="exact")
+        """,
+        "afmdyn.reconstruct(**curve, progress=p)",
+    ),
+    # 2000 values of z_c from 18 nm in steps of 1 pm
+    "peakforce": ("", "afmdyn.peakforce(probe=EX + '/probe-peakforce-amo-garcia.toml', "
+                      "z_c=18e-9 - 1e-12 * np.arange(2000), progress=p)"),
+    # a quasi-static Hertz approach of a million rows on the probe's lever and sample
+    # (door.rs's hertz_curve), with the profile likelihood intervals
+    "fit": (
+        """
+        x = np.linspace(1e-6, -1.5e-6, 1_000_000)
+        f = 4 / 3 * (10e3 / 0.75) * np.sqrt(5e-6) * np.clip(-x, 0, None) ** 1.5
+        curve = {"height": x - f / 0.05, "force": f}
+        """,
+        "afmdyn.fit(data=curve, probe=EX + '/probe-fit-hertz.toml', profiles=True, progress=p)",
+    ),
+}
+
+
+def test_every_request_kind_has_its_interrupt_case():
+    """Every name of the library's registry has its case in ``LONG`` (a new request kind cannot
+    go untested); the one without a long size ends at once, so there is nothing to cancel."""
+    from afmdyn import _afmdyn as core
+
+    assert sorted(LONG) == sorted(core.REQUEST_NAMES)
+    assert [n for n, c in LONG.items() if c is None] == ["modes"]
+    t0 = time.monotonic()
+    afmdyn.modes(modes=20)
+    assert time.monotonic() - t0 < 5
+
+
+def _interrupt_timed(script: str, after: float = 0.1, timeout: float = 60):
+    """Run ``script`` in a child Python, send it SIGINT ``after`` seconds after it printed
+    "start": its exit code, its other lines each with the seconds from the signal to when it
+    was read, its stderr, and the seconds from the signal to its exit."""
+    p = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(script)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    lines: "queue.Queue" = queue.Queue()
+    err = []
+
+    def read_out():
+        for line in p.stdout:
+            lines.put((line.strip(), time.monotonic()))
+        lines.put((None, time.monotonic()))
+
+    threading.Thread(target=read_out, daemon=True).start()
+    reader = threading.Thread(target=lambda: err.append(p.stderr.read()), daemon=True)
+    reader.start()
+
+    def fail(why: str):
+        p.kill()
+        p.wait()
+        reader.join(10)
+        pytest.fail(f"{why}: {''.join(err)[-2000:]}")
+
+    try:
+        first, _ = lines.get(timeout=timeout)
+    except queue.Empty:
+        fail(f"no start within {timeout} s")
+    if first != "start":
+        fail(f"printed {first!r} instead of start")
+    time.sleep(after)  # inside the computation (each takes far longer)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    try:
+        code = p.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        fail(f"still running {timeout} s after SIGINT")
+    exited = time.monotonic() - sent
+    out = []
+    while True:
+        line, t = lines.get(timeout=timeout)
+        if line is None:
+            break
+        out.append((line, t - sent))
+    reader.join(timeout)
+    return code, out, "".join(err), exited
+
+
+@pytest.mark.parametrize("name", [n for n, c in LONG.items() if c is not None])
+def test_ctrl_c_cancels_every_request_kind_within_a_second(name):
+    """Issue 77 item 2: every request kind, started at a size that runs for seconds and sent
+    SIGINT 100 ms into its computation (the child prints "start" from the progress callback,
+    which the waiting thread calls at its first poll, so the work is running by then), raises
+    KeyboardInterrupt within 1 s of the signal: the call cancels the run and waits for it
+    (``run.rs``), so "interrupted" is printed once the computation has stopped. The process
+    then exits (its teardown is not part of the bound)."""
+    setup, call = LONG[name]
+    code, out, err, exited = _interrupt_timed(
+        f"""
+        import numpy as np
+        import afmdyn
+        EX = {str(EXAMPLES)!r}
+        {textwrap.indent(textwrap.dedent(setup), " " * 8).strip()}
+        started = []
+
+        def p(done, total):
+            if not started:
+                started.append(True)
+                print("start", flush=True)
+
+        try:
+            {call}
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        """
+    )
+    print(f"{name}: interrupted {out[0][1] if out else float('nan'):.3f} s after SIGINT, "
+          f"exited after {exited:.3f} s")
+    assert code == 0, err
+    assert [line for line, _ in out] == ["interrupted"], (out, err)
+    assert out[0][1] < 1.0, f"{name}: KeyboardInterrupt {out[0][1]:.2f} s after SIGINT"
     assert "Traceback" not in err and "panicked" not in err, err
 
 

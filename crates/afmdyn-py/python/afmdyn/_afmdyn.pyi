@@ -14,6 +14,9 @@ def cancel_running() -> None: ...
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
 FORCE_SIGN: str
+#: The names of the analyses of the one door ``run`` (the library's registry,
+#: ``afmdyn::request::named::NAMES``).
+REQUEST_NAMES: List[str]
 #: The columns of a bifurcation sweep's records (``afmdyn::request::sweep::COLUMNS``, the CSV's)
 #: and their numeric form (``NUMERIC_COLUMNS``, the ``.npy``'s): (name, unit, meaning).
 SWEEP_COLUMNS: List[Tuple[str, str, str]]
