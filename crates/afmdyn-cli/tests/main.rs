@@ -13,6 +13,7 @@ mod chart;
 mod cli;
 mod fm;
 mod image;
+mod interrupt;
 mod laws;
 mod limits_and_files;
 mod long_runs;
