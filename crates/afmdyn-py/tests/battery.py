@@ -27,7 +27,11 @@ classes: an image beyond its memory budget refused before any work (``--pixels 2
 against an eigenmode probe's own modes, and off-resonance tapping's exclusive ``--z-c`` and
 ``--setpoint`` and a modulation frequency beyond 1 MHz (each exit 2 naming the input); and
 issue 62's force-curve fit: ``fit --data /dev/zero``, a parameter the law does not have, a
-reversed ``--range``, and in Python too few rows and an unknown parameter.
+reversed ``--range``, and in Python too few rows and an unknown parameter; and issue 77's: a
+PeakForce image no material reaches (exit 1), a filter cut-off and a peak-force setpoint out of
+reach, a tapping request on an off-resonance probe, a column named twice, a sub-atomic tip
+radius (exit 2 naming each), and Python keywords of the wrong type (``data=5``,
+``spring_constant='40'``).
 
 The cases are a pure function of the seed, so a run is reproducible. ``test_battery.py`` runs a
 bounded slice in the test command; ``scripts/battery.sh`` runs the whole battery and rewrites
@@ -158,6 +162,23 @@ FAULTS: List[Tuple[List[str], int, Optional[str], Optional[str], Optional[str]]]
       "--files", "none"], 2, "fit", None, None),
     (["fit", "--probe", str(FIT_PROBE), "--data", str(FIT_DATA), "--range", "0,-1e-7",
       "--files", "none"], 2, "range", None, None),
+    # issue 77's classes: a PeakForce image no material reaches (exit 1, not a map of no
+    # finite pixel), a filter cut-off far below f_m and a setpoint no z_c gives (exit 2 naming
+    # them), a tapping request on an off-resonance probe, a data file naming a column twice,
+    # a tip radius below an atom's
+    (["image", "--mode", "peakforce", "--probe", str(PEAKFORCE), "--sample",
+      str(REPO / "examples" / "sample-peakforce-blend.toml"), "--setpoint", "0.7", "--pixels",
+      "2", "--files", "none"], 1, "setpoint", None, None),
+    (["peakforce", "--probe", str(PEAKFORCE), "--filter-cutoff", "1e-308", "--files", "none"],
+     2, "filter-cutoff", None, None),
+    (["peakforce", "--probe", str(PEAKFORCE), "--setpoint", "1e-30", "--files", "none"], 2,
+     "setpoint", None, None),
+    (["approach", "--probe", str(PEAKFORCE), "--points", "3", "--files", "none"], 2,
+     "drive.mode", None, None),
+    (["fit", "--probe", str(FIT_PROBE), "--data", "{probe}", "--files", "none"], 2, "twice",
+     None, "height,force,height\n1e-9,1e-9,2e-9\n"),
+    (["fit", "--probe", "{probe}", "--data", str(FIT_DATA), "--files", "none"], 2, "radius",
+     None, re.sub(r"(?m)^radius = \S+", "radius = 1e-308", FIT_PROBE.read_text())),
 ]
 #: issue 42's Python faults: (call, the keyword its ValueError must name)
 PY_FAULTS = [
@@ -173,6 +194,11 @@ PY_FAULTS = [
     (f"afmdyn.fit(probe={str(FIT_PROBE)!r}, data={{'height': [1, 0, -1], 'force': [0, 1, 2]}})",
      "data"),
     (f"afmdyn.fit(probe={str(FIT_PROBE)!r}, data={str(FIT_DATA)!r}, fit=['tip.nonsense'])", "fit"),
+    # issue 77: keywords convert one way (a string is never read as its characters)
+    (f"afmdyn.fit(probe={str(FIT_PROBE)!r}, data=5)", "data"),
+    ("afmdyn.reconstruct(distance=[1e-9, 2e-9, 3e-9], frequency_shift=[-1.0, -2.0, -3.0], "
+     "spring_constant='40', resonance_frequency=3e5, amplitude=1e-8)", "spring_constant"),
+    ("afmdyn.approach(points='5', progress=False)", "points"),
 ]
 #: a message that prints a double with all its digits (1e300 as 301 digits, 16 of round-off)
 LONG_NUMBER = re.compile(r"\d{17,}")
