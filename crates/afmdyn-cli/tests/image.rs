@@ -487,7 +487,11 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // the door's convergence state: every pixel of the reference image has its point
+    let converged = doc.as_object_mut().unwrap().remove("converged").unwrap();
+    assert_eq!(converged["all"], true, "{converged}");
+    assert_eq!(converged["of"], 8, "{converged}"); // a line map of 8 pixels
     let table: toml::Table = text.parse().unwrap();
     let map = SampleMap::load(std::path::Path::new(&format!(
         "{root}examples/sample-stripe.toml"

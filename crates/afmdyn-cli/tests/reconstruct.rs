@@ -178,6 +178,14 @@ fn an_unconverged_exact_inversion_is_warned_of() {
     assert_eq!(warned(&err), !converged, "{err}");
     // the documented example is such a curve: its residual sits at the data's end
     assert!(!converged, "{}", doc["exact"]);
+    // the door's convergence state says it too, first among the warnings
+    assert_eq!(doc["converged"]["all"], false, "{}", doc["converged"]);
+    assert_eq!(doc["converged"]["part"], "exact inversion");
+    let first = doc["warnings"][0].as_str().unwrap();
+    assert!(
+        first.starts_with("convergence: 1 of 1 exact inversion"),
+        "{first}"
+    );
 }
 
 /// Constants outside their physical range are refused naming the flag and the range (1e300 m

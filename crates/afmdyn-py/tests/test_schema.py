@@ -44,7 +44,7 @@ COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
-SHARED = ["params", "si"]
+SHARED = ["params", "si", "converged"]
 PYTHON_ONLY = ["observe"]
 
 
@@ -322,8 +322,8 @@ def test_each_schema_refuses_a_missing_key_and_an_unknown_one(
             broken = dict(doc, unexpected_key=1)
             with pytest.raises(ValidationError):
                 v.validate(broken)
-        # the shared parts: params in every document, si with a probe
-        for part, key in [("params", "omega"), ("si", "scales")]:
+        # the shared parts: params in every document, si with a probe, converged
+        for part, key in [("params", "omega"), ("si", "scales"), ("converged", "settled")]:
             if part in doc:
                 broken = copy.deepcopy(doc)
                 del broken[part][key]

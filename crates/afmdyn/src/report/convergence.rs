@@ -44,7 +44,11 @@ impl Convergence {
 
     /// The parts of `parts` for which `settled` holds.
     pub fn count<T>(part: &'static str, parts: &[T], settled: impl Fn(&T) -> bool) -> Self {
-        Self::of(part, parts.iter().filter(|p| settled(p)).count(), parts.len())
+        Self::of(
+            part,
+            parts.iter().filter(|p| settled(p)).count(),
+            parts.len(),
+        )
     }
 
     /// Whether every part settled.
@@ -53,10 +57,12 @@ impl Convergence {
     }
 
     /// The door's part of a document ([`crate::request::document`]): `"converged"`
-    /// (`part`, `settled`, `of`, and `all`: whether every part settled) and, where a part did not settle, a warning
-    /// naming how many, joined to the document's warnings (or as them).
+    /// (`part`, `settled`, `of`, and `all`: whether every part settled) and, where a part did
+    /// not settle, a warning naming how many, first among the document's warnings. A document
+    /// that states its convergence already (one a front end also builds outside the door: a
+    /// chart's cells for Dask) is left as it is.
     pub(crate) fn write_into(&self, doc: &mut Value) {
-        if !doc.is_object() || *self == Self::NOTHING {
+        if !doc.is_object() || *self == Self::NOTHING || doc.get("converged").is_some() {
             return;
         }
         doc["converged"] = serde_json::json!({
@@ -88,8 +94,7 @@ mod tests {
     #[test]
     fn a_partial_result_is_written_and_warned_of_and_a_whole_one_only_written() {
         let mut doc = serde_json::json!({"warnings": ["w"]});
-        Convergence::count("points", &[1.0, f64::NAN, 2.0], |x| x.is_finite())
-            .write_into(&mut doc);
+        Convergence::count("points", &[1.0, f64::NAN, 2.0], |x| x.is_finite()).write_into(&mut doc);
         assert_eq!(doc["converged"]["settled"], 2);
         assert_eq!(doc["converged"]["of"], 3);
         assert_eq!(doc["converged"]["all"], false);

@@ -384,6 +384,7 @@ pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> V
 pub(crate) mod basins;
 mod branches;
 pub(crate) mod chart_layout;
+mod convergence;
 pub(crate) mod curve_layout;
 #[cfg(feature = "files")]
 mod curve_table;
@@ -398,6 +399,7 @@ pub(crate) mod simulate_files;
 pub(crate) mod sweep;
 mod units;
 pub(crate) use branches::*;
+pub use convergence::Convergence;
 #[cfg(feature = "files")]
 pub(crate) use curve_table::*;
 pub(crate) use curves::*;

@@ -116,6 +116,9 @@ pub trait Analysis: Request {
     /// # Errors
     /// [`SimError`] where the document needs the model built again (an invalid `params`).
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
+    /// How many of `output`'s parts converged, which [`document`] writes into every document
+    /// and warns of where one did not (no default: every result states it).
+    fn convergence(&self, output: &Self::Output) -> report::Convergence;
     /// The parameters `output` holds, for its SI block ([`document`]): [`Request::computed_at`],
     /// unless the result found one of them (a PeakForce setpoint's rest distance z_c).
     ///
@@ -261,6 +264,7 @@ pub fn document<A: Analysis + ?Sized>(
             w.extend(warnings.into_iter().map(Value::from));
         }
     }
+    analysis.convergence(output).write_into(&mut doc);
     // no missing value unsaid, and no document of missing values only
     report::audit_missing(&mut doc, analysis.name())?;
     Ok(doc)

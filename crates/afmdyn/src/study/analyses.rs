@@ -8,7 +8,7 @@ use crate::analysis::continuation::{
     continue_branch, continue_with_switching, Branch, ContinuationSpec,
 };
 use crate::analysis::converge::{mode_convergence, ConvergenceRun};
-use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovSpectrum};
+use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovSpectrum, MIN_PERIODS};
 use crate::analysis::observables::{observe_from, ObservableOptions};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
@@ -18,7 +18,7 @@ use crate::integrate::{build, IntegratorOptions};
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::Params;
-use crate::report::{self, CurveUnits};
+use crate::report::{self, Convergence, CurveUnits};
 use crate::request::analyses::{
     initial_state, AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest,
     ObserveRequest, ObserveResult, OrbitRequest, StartRequest,
@@ -287,6 +287,9 @@ pub fn advance_from_rest(params: &Params, periods: usize) -> Result<Vec<f64>, Si
 
 impl Analysis for OrbitRequest {
     type Output = PeriodicOrbit;
+    fn convergence(&self, _: &PeriodicOrbit) -> Convergence {
+        Convergence::exact("orbit") // Newton's failure is an error
+    }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
         self.run(&model.params)
     }
@@ -304,6 +307,11 @@ impl Analysis for OrbitRequest {
 
 impl Analysis for ContinuationRequest {
     type Output = Vec<Branch>;
+    fn convergence(&self, branches: &Self::Output) -> Convergence {
+        Convergence::count("branches", branches, |b| {
+            b.end.warning(self.param, 1).is_none()
+        })
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
@@ -328,6 +336,17 @@ impl Analysis for ContinuationRequest {
 
 impl Analysis for LyapunovRequest {
     type Output = LyapunovSpectrum;
+    fn convergence(&self, l: &Self::Output) -> Convergence {
+        // an exponent within 2 × (uncertainty + convergence) of zero has not converged to
+        // its sign, nor has any of a run shorter than its minimum
+        let errors = l.uncertainty.iter().zip(&l.convergence);
+        let resolved = l.exponents.iter().zip(errors);
+        let resolved = resolved
+            .filter(|(e, (u, c))| e.abs() > 2.0 * (*u + *c))
+            .count();
+        let resolved = if l.periods < MIN_PERIODS { 0 } else { resolved };
+        Convergence::of("exponents", resolved, l.exponents.len())
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
@@ -349,6 +368,10 @@ impl Analysis for LyapunovRequest {
 
 impl Analysis for AttractorsRequest {
     type Output = AttractorReport;
+    fn convergence(&self, r: &Self::Output) -> Convergence {
+        let settled = r.attractors.iter().map(|a| a.count).sum();
+        Convergence::of("random starts", settled, self.samples)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
@@ -376,6 +399,10 @@ impl Analysis for AttractorsRequest {
 
 impl Analysis for ObserveRequest {
     type Output = ObserveResult;
+    fn convergence(&self, o: &Self::Output) -> Convergence {
+        // the steady state's end point is observed as it is where Newton found no orbit
+        Convergence::of("periodic orbit", usize::from(o.period.is_some()), 1)
+    }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params)
     }
@@ -389,6 +416,9 @@ impl Analysis for ObserveRequest {
 
 impl Analysis for ConvergeRequest {
     type Output = Vec<ConvergenceRun>;
+    fn convergence(&self, runs: &Self::Output) -> Convergence {
+        Convergence::count("mode counts' steady states", runs, |r| r.period.is_some())
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
@@ -416,10 +446,10 @@ impl Analysis for ConvergeRequest {
 mod tests {
     use super::*;
     use crate::params::Params;
-    use crate::request::analyses::{AttractorsRequest, OrbitRequest};
+    use crate::request::analyses::{AttractorsRequest, LyapunovRequest, OrbitRequest};
     use crate::request::run::run;
 
-    /// The document of `run` is the report of the typed result with the SI block, and a
+    /// The document of `run` is the report of the typed result with its convergence, and a
     /// cancelled progress stops a run before it starts.
     #[test]
     fn run_builds_the_reports_document_and_honours_cancel() {
@@ -430,7 +460,8 @@ mod tests {
         let request = OrbitRequest::default();
         let progress = Progress::new();
         let doc = run(&request, &model, &progress).unwrap();
-        let want = report::orbit(&CantileverModel::new(&model.params).unwrap(), &doc.output);
+        let mut want = report::orbit(&CantileverModel::new(&model.params).unwrap(), &doc.output);
+        Convergence::exact("orbit").write_into(&mut want);
         assert_eq!(doc.json, want);
         assert_eq!(doc.output.period, 2);
         progress.cancel();
@@ -459,5 +490,39 @@ mod tests {
         let err = request.execute(&model, &cancelled).unwrap_err();
         assert!(matches!(err, SimError::Cancelled), "{err}");
         assert_eq!(cancelled.done(), 6);
+        // every start that reached an attractor converged (the census's own counts)
+        let counted: usize = doc.output.attractors.iter().map(|a| a.count).sum();
+        assert_eq!(doc.json["converged"]["settled"], counted);
+        assert_eq!(doc.json["converged"]["of"], 6);
+    }
+
+    /// A Lyapunov run shorter than its minimum of 200 periods has not converged to the
+    /// exponents' signs (`run_warnings` says so): none of its 2N exponents is counted settled,
+    /// and the door's first warning says how many did not converge.
+    #[test]
+    fn a_short_lyapunov_run_is_no_converged_spectrum() {
+        let model = Resolved::plain(Params::default());
+        let request = LyapunovRequest {
+            periods: 50,
+            blocks: 2,
+            ..LyapunovRequest::default()
+        };
+        let doc = run(&request, &model, &Progress::new()).unwrap();
+        let n = doc.output.exponents.len();
+        assert_eq!(n, 2 * model.params.modes);
+        let c = &doc.json["converged"];
+        assert_eq!(
+            (c["settled"].as_u64(), c["of"].as_u64()),
+            (Some(0), Some(n as u64))
+        );
+        assert_eq!(c["all"], false);
+        let first = doc.json["warnings"][0].as_str().unwrap();
+        let says = format!("convergence: {n} of {n} exponents did not converge");
+        assert!(first.starts_with(&says), "{first}");
+        // the spectrum's own warning is still there, after it
+        let own = doc.json["warnings"].as_array().unwrap().iter();
+        assert!(own
+            .skip(1)
+            .any(|w| w.as_str().unwrap().starts_with("only 50 periods")));
     }
 }

@@ -11,12 +11,13 @@
 //! memory.
 
 use super::{execute_in_memory, Chain};
-use crate::analysis::basins::{basin_map, run_passes, BasinMap, BasinRow, BasinSpec};
+use crate::analysis::basins::{basin_map, run_passes, BasinMap, BasinRow, BasinSpec, Decided};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::report::basins::document;
+use crate::report::Convergence;
 use crate::request::costs::{basins_cost, check_cost};
 use crate::request::run::{Analysis, Resolved};
 use crate::request::BasinsRequest;
@@ -96,6 +97,9 @@ impl BasinStudy {
 
 impl Analysis for BasinsRequest {
     type Output = BasinMap;
+    fn convergence(&self, map: &BasinMap) -> Convergence {
+        Convergence::count("cells", &map.cells, |c| c.decided != Decided::Failed)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
         let study = BasinStudy::new(self, &model.params)?;
         let records = execute_in_memory(&study.chain(), self.threads, progress)?;

@@ -12,6 +12,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::layout::Layout;
 use crate::report::chart_layout::ChartAxis;
+use crate::report::Convergence;
 use crate::request::chart::{axis_unit, Chart, ChartArrays};
 use crate::request::parameter;
 use crate::request::run::Analysis;
@@ -35,6 +36,9 @@ impl Chart {
 
 impl Analysis for Chart {
     type Output = Vec<ChartCell>;
+    fn convergence(&self, cells: &Vec<ChartCell>) -> Convergence {
+        convergence(cells)
+    }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Vec<ChartCell>, SimError> {
         let cells = cells_of(execute_in_memory(&self.tasks(), self.threads, progress)?);
         match every_cell_failed(&cells) {
@@ -204,9 +208,20 @@ pub(crate) fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
     w
 }
 
+/// The cells that converged: no failed start, and no attractor still settling at the transient
+/// cap (λ₁ < 0 without a period).
+fn convergence(cells: &[ChartCell]) -> Convergence {
+    use crate::analysis::chart::{ChartAttractor, MotionKind};
+    Convergence::count("cells", cells, |c| {
+        let unsettled = |a: &ChartAttractor| matches!(a.motion(), MotionKind::Unsettled);
+        c.failures == 0 && c.message.is_none() && !c.attractors.iter().any(unsettled)
+    })
+}
+
 /// The `--json` document of a chart: the parameters of its first cell (x₀, y₀; the other cells
 /// differ in the two axes), axes with names, units and values; every cell with its attractors;
-/// the counts; with a probe the `si` block of the first cell.
+/// the counts and the cells that converged (`converged`); with a probe the `si` block of the
+/// first cell.
 pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
     let axis = |name: &str, values: &[f64]| json!({"name": name, "unit": axis_unit(name), "values": values});
     let cells_json: Vec<Value> = cells
@@ -243,10 +258,13 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
         "failures": cells.iter().map(|c| c.failures as u64).sum::<u64>(),
         "warnings": warnings(chart, cells),
     });
-    match &first {
+    let mut doc = match &first {
         Ok(p) => crate::report::with_si(doc, chart.model.probe.as_ref(), p),
         Err(_) => doc,
-    }
+    };
+    // its convergence here (Dask and Python build it outside the door, which leaves it)
+    convergence(cells).write_into(&mut doc);
+    doc
 }
 
 #[cfg(test)]

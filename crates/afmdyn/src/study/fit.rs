@@ -19,6 +19,7 @@ use crate::analysis::progress::Progress;
 use crate::contact::LawKind;
 use crate::error::SimError;
 use crate::probe::SampleInputs;
+use crate::report::Convergence;
 use crate::request::fit::{bad, check_columns, FitRequest};
 use crate::request::fit_result::{probe_value, MIN_FIT_ROWS};
 use crate::request::run::{Analysis, Resolved};
@@ -201,6 +202,9 @@ fn contact_point_warning(height: &[f64], contact: f64) -> Option<String> {
 
 impl Analysis for FitRequest {
     type Output = FitResult;
+    fn convergence(&self, r: &FitResult) -> Convergence {
+        Convergence::of("minimiser", usize::from(r.outcome.converged), 1)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
         if let Some(data) = crate::request::fit_dynamic::read_am_data(self.data.as_deref())? {
             // `range` of a dynamic curve: the piezo positions z fitted

@@ -7,7 +7,7 @@ use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::layout::columns::{self, columns, Column, UnitNames};
-use crate::report::CurveUnits;
+use crate::report::{Convergence, CurveUnits};
 use crate::request::fm::FmRequest;
 use crate::request::run::{Analysis, Resolved};
 use crate::study::named::{Arrays, Datasets};
@@ -15,6 +15,10 @@ use serde_json::{json, Value};
 
 impl Analysis for FmRequest {
     type Output = FmCurve;
+    fn convergence(&self, curve: &FmCurve) -> Convergence {
+        let reached = usize::from(curve.unreached.is_none());
+        Convergence::of("curve to the end of its range", reached, 1)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
         crate::request::curves::check_single_frequency(&model.params, "fm")?;
         fm_curve(&self.spec(model)?, progress)

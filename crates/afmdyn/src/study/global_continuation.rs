@@ -18,7 +18,7 @@ use crate::analysis::global_continuation::{
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::params::Params;
-use crate::report;
+use crate::report::{self, Convergence};
 use crate::request::costs::{census_cost, check_cost};
 use crate::request::run::{Analysis, Resolved};
 use crate::request::GlobalContinuationRequest;
@@ -99,6 +99,11 @@ impl ContinuationStudy {
 
 impl Analysis for GlobalContinuationRequest {
     type Output = Vec<ContinuationStep>;
+    fn convergence(&self, steps: &Self::Output) -> Convergence {
+        Convergence::count("values", steps, |s| {
+            s.failures.is_empty() && !s.attractors.iter().any(|(_, a)| a.unsettled())
+        })
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         let study = ContinuationStudy::new(self, &model.params)?;
         let records = execute_in_memory(&study.chain(), None, progress)?;

@@ -11,7 +11,7 @@ use super::scan::ScanStudy;
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::report::image::PeakForceImage;
-use crate::report::Presentation;
+use crate::report::{Convergence, Presentation};
 use crate::request::image::{Image, SetpointStudy};
 use crate::request::image_job::{ImageJob, ImageMode};
 use crate::request::run::{Analysis, Request, Resolved};
@@ -35,7 +35,9 @@ impl ImageJob {
 
 impl Analysis for ImageJob {
     type Output = ImageOutput;
-
+    fn convergence(&self, output: &ImageOutput) -> Convergence {
+        output.convergence()
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ImageOutput, SimError> {
         self.validate(model)?;
         if self.mode == ImageMode::Peakforce {
@@ -128,6 +130,23 @@ pub enum ImageOutput {
 }
 
 impl ImageOutput {
+    /// Its pixels that converged: those with an operating point (ideal, and the PI scan's
+    /// reference image), or a steady tap at the setpoint (PeakForce).
+    fn convergence(&self) -> Convergence {
+        let pixels = |image: &Image| -> Convergence {
+            let rows = image.pixels.iter().flatten().collect::<Vec<_>>();
+            Convergence::count("pixels", &rows, |p| p.point.is_some())
+        };
+        match self {
+            ImageOutput::Ideal { image, .. } => pixels(image),
+            ImageOutput::Pi(pi) => pixels(&pi.ideal),
+            ImageOutput::PeakForce(pf) => {
+                let rows = pf.pixels.iter().flatten().collect::<Vec<_>>();
+                Convergence::count("pixels", &rows, |p| p.tap.is_some())
+            }
+        }
+    }
+
     /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
     /// `image.nc`'s variables, `super::image_layout`) and, as the fact `summary`, the
     /// command line's `image.json` ([`crate::report::present::image`]).
@@ -151,6 +170,9 @@ impl ImageOutput {
                 peakforce_summary(img),
             ),
         };
+        // the summary is the command line's document: with its convergence, as the door's
+        let mut summary = summary;
+        self.convergence().write_into(&mut summary);
         let mut facts = serde_json::Map::new();
         facts.insert("summary".into(), summary);
         Outcome {

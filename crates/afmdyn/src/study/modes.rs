@@ -5,7 +5,7 @@ use crate::analysis::progress::Progress;
 use crate::eigen::{fig3_sweep, spectrum, Fig3Point, RegionSpectrum};
 use crate::error::SimError;
 use crate::params::Params;
-use crate::report;
+use crate::report::{self, Convergence};
 use crate::request::modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};
 use crate::request::run::{Analysis, Resolved};
 use crate::units::Scales;
@@ -13,6 +13,9 @@ use serde_json::{json, Value};
 
 impl Analysis for ModesRequest {
     type Output = (RegionSpectrum, RegionSpectrum);
+    fn convergence(&self, _: &Self::Output) -> Convergence {
+        Convergence::exact("eigenproblem")
+    }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         Ok(spectrum(&model.params)?)
     }
@@ -35,6 +38,9 @@ impl Analysis for ModesRequest {
 
 impl Analysis for Fig3Request {
     type Output = Vec<Fig3Point>;
+    fn convergence(&self, _: &Self::Output) -> Convergence {
+        Convergence::exact("eigenproblems")
+    }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         let (alpha1, alpha4) = (
             crate::report::present::modes::fig3_alpha1(),
@@ -64,6 +70,9 @@ impl Analysis for Fig3Request {
 impl Analysis for UnitsRequest {
     /// The physical model's dimensionless set and scales (`None`: the probe's model).
     type Output = Option<(Params, Scales)>;
+    fn convergence(&self, _: &Self::Output) -> Convergence {
+        Convergence::NOTHING // a unit conversion
+    }
     fn execute(&self, _: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         match &self.physical {
             Some(m) => Ok(Some((m.to_params()?, m.scales()))),
@@ -101,6 +110,9 @@ impl Analysis for UnitsRequest {
 
 impl Analysis for CantileversRequest {
     type Output = ();
+    fn convergence(&self, _: &()) -> Convergence {
+        Convergence::NOTHING // the lever library
+    }
     fn execute(&self, _: &Resolved, _: &Progress) -> Result<(), SimError> {
         Ok(())
     }

@@ -24,7 +24,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
-use crate::report::CurveUnits;
+use crate::report::{Convergence, CurveUnits};
 use crate::request::{Analysis, PeakForceRequest, PeakForceSweep, Resolved};
 use nalgebra::DVector;
 use serde_json::{json, Value};
@@ -129,6 +129,12 @@ impl PeakForceStudy {
 
 impl Analysis for PeakForceRequest {
     type Output = PeakForceResult;
+    fn convergence(&self, r: &PeakForceResult) -> Convergence {
+        match &r.sweep {
+            Some(taps) => Convergence::count("taps", taps, |t| t.tap.is_some()),
+            None => Convergence::exact("tap"), // a tap that does not settle is an error
+        }
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
         let p = self.params(model)?;
         if let Some(sweep) = &self.sweep {

@@ -10,6 +10,7 @@ use crate::analysis::reconstruct_exact::exact_inversion;
 use crate::error::SimError;
 use crate::layout::Layout;
 use crate::report::present::reconstruct::{reconstruction, Inversion};
+use crate::report::Convergence;
 use crate::request::reconstruct::{
     am_curve_from_approach, AmReconstruction, FmInversion, ReconstructRequest,
 };
@@ -20,6 +21,9 @@ use serde_json::{json, Value};
 
 impl Analysis for ReconstructRequest {
     type Output = Reconstruction;
+    fn convergence(&self, r: &Reconstruction) -> Convergence {
+        inversion_convergence(r)
+    }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
         match self.inversion {
             FmInversion::SaderJarvis => sader_jarvis(&self.curve()?, progress),
@@ -60,6 +64,9 @@ fn present_reconstruction(
 
 impl Analysis for AmReconstruction {
     type Output = Reconstruction;
+    fn convergence(&self, r: &Reconstruction) -> Convergence {
+        inversion_convergence(r)
+    }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
         let curve = am_curve_from_approach(&self.0)?;
         crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)
@@ -119,6 +126,16 @@ pub(crate) fn document(request: &ReconstructRequest, r: &Reconstruction) -> Valu
         }
     }
     doc
+}
+
+/// An inversion's convergence: Sader–Jarvis's closed form is direct, the exact inversion's
+/// iteration converged or stopped above round-off.
+fn inversion_convergence(r: &Reconstruction) -> Convergence {
+    r.exact
+        .as_ref()
+        .map_or(Convergence::exact("inversion"), |e| {
+            Convergence::of("exact inversion", usize::from(e.converged), 1)
+        })
 }
 
 /// The warning of an exact inversion that did not converge to round-off

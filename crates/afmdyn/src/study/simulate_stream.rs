@@ -17,8 +17,8 @@ use crate::layout::files::f;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::report::simulate_files::{SeriesFiles, SERIES_FILES};
-use crate::report::Presentation;
 use crate::report::{self, SeriesUnits, SimulateSummary};
+use crate::report::{Convergence, Presentation};
 use crate::request::analyses::initial_state;
 use crate::request::run::{Analysis, Resolved};
 use crate::request::simulate_stream::{
@@ -47,6 +47,10 @@ pub struct SimulateRecording {
 
 impl Analysis for SimulateStream {
     type Output = SimulateRecording;
+    fn convergence(&self, _: &SimulateRecording) -> Convergence {
+        // a trajectory from its start, nothing iterated (its energy audit warns on its own)
+        Convergence::exact("trajectory")
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         let p = &model.params;
         let span = self.span(p)?;

@@ -20,8 +20,8 @@ use crate::analysis::stepped::{
     check_values, finish_curve, sweep_points, CurvePoint, SteppedCurve, SteppedSpec,
 };
 use crate::error::SimError;
-use crate::report;
 use crate::report::present::curves::{stepped, CurveKind};
+use crate::report::{self, Convergence};
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::run::{
     Analysis, ApproachRequest, Bimodal, Request, Resolved, ResonanceRequest,
@@ -156,8 +156,20 @@ macro_rules! present_curve {
     };
 }
 
+/// A stepped curve's convergence: its points of both sweeps, a time-averaged point that did
+/// not settle within its transient cap counted out.
+fn curve_convergence(c: &SteppedCurve) -> Convergence {
+    let points: Vec<_> = c.first.iter().chain(&c.second).collect();
+    Convergence::count("points", &points, |p| {
+        p.average.as_ref().is_none_or(|a| a.settled)
+    })
+}
+
 impl Analysis for ApproachRequest {
     type Output = SteppedCurve;
+    fn convergence(&self, c: &SteppedCurve) -> Convergence {
+        curve_convergence(c)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         CurveStudy::approach(self, model)?.run_in_memory(progress)
     }
@@ -192,6 +204,9 @@ impl Analysis for ApproachRequest {
 
 impl Analysis for ResonanceRequest {
     type Output = SteppedCurve;
+    fn convergence(&self, c: &SteppedCurve) -> Convergence {
+        curve_convergence(c)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         CurveStudy::resonance(self, model)?.run_in_memory(progress)
     }
@@ -273,6 +288,9 @@ fn soft_sample_warning(
 
 impl Analysis for Bimodal {
     type Output = SteppedCurve;
+    fn convergence(&self, c: &SteppedCurve) -> Convergence {
+        curve_convergence(c)
+    }
     fn execute(
         &self,
         model: &Resolved,

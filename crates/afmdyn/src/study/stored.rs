@@ -24,6 +24,7 @@ use crate::analysis::progress::Progress;
 use crate::analysis::stepped::SteppedCurve;
 use crate::error::SimError;
 use crate::report::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, SweepTally};
+use crate::report::Convergence;
 use crate::request::chart::Chart;
 use crate::request::image_job::ImageJob;
 use crate::request::run::Bimodal;
@@ -330,6 +331,11 @@ impl Request for SweepInto {
 
 impl Analysis for SweepInto {
     type Output = SweepFiles;
+    fn convergence(&self, files: &SweepFiles) -> Convergence {
+        let t = &files.tally;
+        let settled = t.periodic + t.nonperiodic;
+        Convergence::of("points", settled, settled + t.errors)
+    }
     fn execute(&self, _: &Resolved, _: &Progress) -> Result<SweepFiles, SimError> {
         Err(SimError::File(NO_DIRECTORY.into()))
     }

@@ -8,6 +8,8 @@ use super::{Resumes, Study};
 use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::report::sweep::PointStatus;
+use crate::report::Convergence;
 use crate::request::run::{Analysis, Resolved};
 use crate::request::sweep::point_count;
 use crate::request::sweep::{records, SweepRecord};
@@ -84,6 +86,9 @@ impl Study for SweepStudy {
 /// first ([`crate::request::run::admit`]) and runs the [`SweepStudy`] itself.
 impl Analysis for BifurcationRequest {
     type Output = Vec<SweepRecord>;
+    fn convergence(&self, records: &Self::Output) -> Convergence {
+        Convergence::count("points", records, |r| r.status != PointStatus::Error)
+    }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         let study = SweepStudy::new(self, self.spec(&model.params)?);
         let mut records: Vec<SweepRecord> =

@@ -89,6 +89,9 @@ pub struct FitOutcome {
     pub residuals: Vec<f64>,
     /// Model evaluations made, the profiles' refits included.
     pub evaluations: usize,
+    /// Whether the minimiser reports convergence (else the estimates may not be at the
+    /// minimum, and a warning says so).
+    pub converged: bool,
     /// The minimiser's termination.
     pub termination: String,
     /// Identifiability and convergence warnings, in words.
@@ -234,6 +237,7 @@ pub fn fit_cancellable(
         fitted,
         residuals,
         evaluations,
+        converged: best.converged,
         termination: best.termination,
         warnings,
     })
