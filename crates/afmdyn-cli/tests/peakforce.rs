@@ -350,3 +350,63 @@ fn a_round_off_dissipation_prints_as_zero() {
         "{text}"
     );
 }
+
+/// A PeakForce image says where its DMT fit reads off the material's own E*, as a single tap
+/// says it, and prints an elastic material's dissipation as round-off, not as a value (issue
+/// 77 §12: "modulus_dmt 140.784 GPa (true E* 2.98787 GPa)" and "dissipation -3.36e-12 aJ"
+/// without a word). The Amo–García probe at f₀/f_m = 10 reads its elastic DMT sample biased far
+/// above E* (its example's own comment): the image's background reads the single tap's ratio.
+#[test]
+fn a_peakforce_image_warns_of_a_biased_modulus_as_a_single_tap_does() {
+    let probe = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/probe-peakforce-amo-garcia.toml"
+    );
+    let ratio_in = |text: &str, before: &str| -> f64 {
+        let at = text
+            .find(before)
+            .unwrap_or_else(|| panic!("{before}: {text}"))
+            + before.len();
+        let number: String = text[at..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || *c == '.')
+            .collect();
+        number.parse().unwrap()
+    };
+    let single = afmdyn(&[
+        "peakforce",
+        "--probe",
+        probe,
+        "--setpoint",
+        "2nN",
+        "--files",
+        "none",
+    ]);
+    let single = String::from_utf8_lossy(&single.stderr).to_string();
+    let tap = ratio_in(&single, "modulus_dmt reads ");
+    assert!((tap - 1.0).abs() > 0.1, "{single}");
+    let dir = tempfile::tempdir().unwrap();
+    let sample = common::flat_sample(dir.path());
+    let out = afmdyn(&[
+        "image",
+        "--mode",
+        "peakforce",
+        "--probe",
+        probe,
+        "--sample",
+        sample.to_str().unwrap(),
+        "--pixels",
+        "2",
+        "--setpoint",
+        "2nN",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let pixels = ratio_in(&err, "background: modulus_dmt reads ");
+    assert!((pixels - tap).abs() <= 1e-3 * tap, "{tap} {err}");
+    assert!(err.contains("on 4 of its 4 single-tap pixels"), "{err}");
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(summary.contains("dissipation 0 (round-off"), "{summary}");
+}

@@ -81,7 +81,12 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 fn every_pixel_holds_the_setpoint_and_a_two_material_sample_gives_both_materials() {
     let img = image(8, 6, 2);
     assert_eq!(img.materials.len(), 2, "background and the stiff domain");
-    assert!(img.warnings.is_empty(), "{:?}", img.warnings);
+    // at f₀/f_m = 100 the DMT fit reads each material ~1.5 × its E* (the sample file's
+    // comment): said per material, as a single tap says it, and nothing else
+    assert_eq!(img.warnings.len(), 2, "{:?}", img.warnings);
+    for (w, m) in img.warnings.iter().zip(["background", "stiff"]) {
+        assert!(w.starts_with(&format!("{m}: modulus_dmt reads ")), "{w}");
+    }
     let mut seen = [0usize; 2];
     for j in 0..img.y.len() {
         for i in 0..img.x.len() {
@@ -291,7 +296,8 @@ fn a_change_of_material_at_every_pixel_costs_one_tap_and_holds_the_setpoint() {
     };
     let one = img(1);
     assert_eq!(one, img(2), "bit for bit on 1 and 2 threads");
-    assert!(one.warnings.is_empty(), "{:?}", one.warnings);
+    let biased = |w: &String| w.contains(": modulus_dmt reads "); // as above
+    assert!(one.warnings.iter().all(biased), "{:?}", one.warnings);
     for j in 0..2 {
         for i in 0..8 {
             let m = one.material[j][i];

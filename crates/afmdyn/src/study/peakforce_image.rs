@@ -442,6 +442,61 @@ fn si_tap(
 }
 
 impl PeakForceImageStudy {
+    /// Where the DMT fit of a material's single-tap pixels reads more than
+    /// [`super::peakforce::MAX_MODULUS_BIAS`] off its own E* (which a simulation knows), as a
+    /// single tap's document says it (issue 77): one warning per such material, with the range
+    /// of the ratio and how many of its pixels.
+    fn modulus_bias(
+        &self,
+        materials: &[PfMaterialReport],
+        pixels: &[Vec<LinePixel>],
+        x: &[f64],
+        y: &[f64],
+    ) -> Vec<String> {
+        let bound = super::peakforce::MAX_MODULUS_BIAS;
+        let mut ratios = vec![Vec::new(); materials.len()];
+        for (row, &yj) in pixels.iter().zip(y) {
+            for (pixel, &xi) in row.iter().zip(x) {
+                let Some(t) = pixel.tap.filter(|t| t.taps_per_cycle <= 1.0 + 1e-9) else {
+                    continue;
+                };
+                let m = self.material_at(xi, yj);
+                let ratio = t.modulus_dmt / materials[m].true_modulus;
+                if ratio.is_finite() {
+                    ratios[m].push(ratio);
+                }
+            }
+        }
+        let biased = |r: &&f64| (**r - 1.0).abs() > bound;
+        materials
+            .iter()
+            .zip(&ratios)
+            .filter_map(|(m, r)| {
+                let off: Vec<f64> = r.iter().filter(biased).copied().collect();
+                let lo = off.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = off.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let reads = if hi - lo > 5e-4 * hi {
+                    format!("{lo:.3}–{hi:.3}")
+                } else {
+                    format!("{hi:.3}")
+                };
+                (!off.is_empty()).then(|| {
+                    format!(
+                        "{}: modulus_dmt reads {reads} × the material's own E* on {} of its \
+                     {} single-tap pixels (more than {:.0} % off): the DMT fit is biased there \
+                     (the lever's inertia and ringing within the tap, an indentation past the \
+                     paraboloid's validity): compare it against a calibration sample, not as \
+                     the material's modulus",
+                        m.name,
+                        off.len(),
+                        r.len(),
+                        bound * 100.0
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// The image of the lines' records (any order).
     ///
     /// # Errors
@@ -502,6 +557,7 @@ impl PeakForceImageStudy {
         if taps().any(|t| t.period > 1) {
             warnings.push("period-2 (or longer) tapping on some pixels (period)".into());
         }
+        warnings.extend(self.modulus_bias(&materials, &pixels, &x, &y));
         if taps().any(|t| !t.stable) {
             warnings.push("unstable steady taps on some pixels (stable = false)".into());
         }

@@ -5,8 +5,8 @@
 use crate::error::number;
 use crate::layout::columns::UnitNames;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
-use crate::report::image::{DomainContrast, Image, OperatingPoint, PeakForceImage, PiImage};
-use crate::report::image::{SetpointStudy, PF_FIELDS};
+use crate::report::image::{DomainContrast, Image, OperatingPoint, PeakForceImage, PeakForceTap};
+use crate::report::image::{PiImage, SetpointStudy, PF_FIELDS};
 use crate::report::image_layout::{layout, number_summary, peakforce_layout, scan_layout, summary};
 use crate::report::{Presentation, TextUnits};
 use serde_json::{json, Value};
@@ -401,6 +401,22 @@ pub(crate) fn peakforce_summary(img: &PeakForceImage) -> Value {
     doc
 }
 
+/// A material's engaged dissipation per cycle for the summary: 0 where it is round-off, within
+/// 1e-9 of the contact's work scale (peak force × deformation: an elastic sample's orbit
+/// closes its energy to ~1e-12 of it), as a single tap's says within its energy balance's
+/// residual (issue 77: "dissipation -3.36e-12 aJ" was printed on an elastic sample).
+fn dissipation(t: &PeakForceTap, u: &TextUnits) -> String {
+    let scale = (t.peak_force * t.deformation).abs();
+    if t.dissipation.abs() <= 1e-9 * scale {
+        format!(
+            "0 (round-off: below 1e-9 of peak force × deformation, {})",
+            u.value(scale, "J")
+        )
+    } else {
+        u.value(t.dissipation, "J")
+    }
+}
+
 /// A PeakForce image: `image.json` (`document`: `peakforce_summary`, or
 /// [`PeakForceImage::document`]), `image.nc`, the maps `image-height`, `image-modulus`,
 /// `image-adhesion`, `image-deformation`, `image-dissipation`, and the summary: every
@@ -454,7 +470,7 @@ pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) ->
                 u.value(m.true_modulus, "Pa"),
                 u.value(t.adhesion, "N"),
                 u.value(t.deformation, "m"),
-                u.value(t.dissipation, "J")
+                dissipation(t, &u)
             )),
             None => s.line(format!(
                 "  {}: not imaged ({})",
