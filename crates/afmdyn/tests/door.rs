@@ -342,8 +342,10 @@ fn case(name: &str) -> Option<Case> {
             long_params: None,
         },
         "reconstruct" => plain(
-            shift_curve(500, "sader-jarvis"),
-            shift_curve(4000, "exact"),
+            // at 4 000 points the model's constant hid the document's 128 B a point, which
+            // 2·10⁶ points showed (464 MB against a declared 282 MB)
+            shift_curve(200_000, "sader-jarvis"),
+            shift_curve(200_000, "exact"),
             Some(shift_curve(1_000_000, "exact")),
         ),
         "peakforce" => Case {

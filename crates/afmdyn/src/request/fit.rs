@@ -383,15 +383,16 @@ impl Request for FitRequest {
             return super::fit_dynamic::cost(d.z.len(), n, profiles, &model.params);
         }
         // no integration; a row of the columns, the preprocessed curve, the Jacobian (≤ 5
-        // columns), the residuals, the document's numbers and the outcome's arrays: 512 bytes
-        // (measured 343 at 1 000 and 20 000 rows, `tests/door.rs`)
+        // columns), the residuals, the document's numbers, the outcome's arrays and the front
+        // end's table and figures: 800 bytes (the library's run 343 at 1 000 to 10⁶ rows,
+        // `tests/door.rs`; the command line's whole heap 747 at 10⁶ rows, heaptrack)
         let rows = if self.data.is_some() {
             MAX_FIT_ROWS
         } else {
             self.force.len()
         } as f64;
         Ok(Cost {
-            bytes: super::costs::MODEL_BYTES + rows * 512.0,
+            bytes: super::costs::MODEL_BYTES + rows * 800.0,
             work: 0.0,
         })
     }
