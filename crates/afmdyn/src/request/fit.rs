@@ -384,15 +384,15 @@ impl Request for FitRequest {
         }
         // no integration; a row of the columns, the preprocessed curve, the Jacobian (≤ 5
         // columns), the residuals, the document's numbers, the outcome's arrays and the front
-        // end's table and figures: 800 bytes (the library's run 343 at 1 000 to 10⁶ rows,
-        // `tests/door.rs`; the command line's whole heap 747 at 10⁶ rows, heaptrack)
+        // end's table and figures: 900 bytes (the library's run 343 at 1 000 to 10⁶ rows,
+        // `tests/door.rs`; the command line's heap 783 and its resident set 818 at 10⁶ rows)
         let rows = if self.data.is_some() {
             MAX_FIT_ROWS
         } else {
             self.force.len()
         } as f64;
         Ok(Cost {
-            bytes: super::costs::MODEL_BYTES + rows * 800.0,
+            bytes: super::costs::MODEL_BYTES + rows * 900.0,
             work: 0.0,
         })
     }

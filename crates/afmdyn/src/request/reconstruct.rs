@@ -337,8 +337,9 @@ impl Request for ReconstructRequest {
         // no integration; memory bounded by the method's own limit (ShiftCurve::method): the
         // FFT's three buffers of 16 bytes × the next power of two ≥ 2n, or the direct sum's
         // O(n) rows; the curve's columns (distance, shift, force, potential, law) and the
-        // document's, four of 32-byte JSON values (at 2·10⁶ points the library's run peaked at
-        // 464 MB, Sader–Jarvis, and 681 MB, exact: 91 B a point above the columns alone)
+        // document's and the front end's, six of 32-byte JSON values (at 2·10⁶ points the
+        // library's run peaked at 464 MB, Sader–Jarvis, and 681 MB, exact, 91 B a point above
+        // the columns alone; the command line's resident set at 537 MB and 763 MB)
         let n = self.frequency_shift.len();
         let curve = self.curve()?;
         let mut work_bytes = match curve.method()? {
@@ -353,7 +354,7 @@ impl Request for ReconstructRequest {
                 + 5.0 * 8.0 * n as f64;
         }
         Ok(Cost {
-            bytes: MODEL_BYTES + work_bytes + (5.0 * 8.0 + 4.0 * 32.0) * n as f64,
+            bytes: MODEL_BYTES + work_bytes + (5.0 * 8.0 + 6.0 * 32.0) * n as f64,
             work: 0.0,
         })
     }
