@@ -73,8 +73,7 @@ impl Convergence {
         });
         if !self.converged() {
             let warning = Value::from(format!(
-                "convergence: {} of {} {} did not converge (converged.settled; the warnings \
-                 say which)",
+                "convergence: {} of {} {} did not converge (the document's converged)",
                 self.of - self.settled,
                 self.of,
                 self.part

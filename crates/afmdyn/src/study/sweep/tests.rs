@@ -143,6 +143,9 @@ fn a_failed_point_is_one_row_with_its_message_and_codes() {
         "omega,2.5,3,start-2,error,,0,1,,,,,,,,,no convergence  after 300 periods,"
     );
     assert_eq!(rows[0].status.code(), -2);
+    // not a converged point of the diagram (the door's `converged`)
+    let c = crate::request::run::Analysis::convergence(&BifurcationRequest::default(), &rows);
+    assert_eq!((c.settled, c.of, c.part), (0, 1, "points"));
     assert_eq!(crate::request::sweep::branch_code(p.branch), 4.0);
     let back = SweepRecord::parse_csv(&rows[0].csv_line()).unwrap();
     assert_eq!(back.status, PointStatus::Error);
