@@ -246,6 +246,12 @@ pub(crate) fn lyapunov_spectrum_with(
 pub(crate) const MIN_PERIODS: usize = 200;
 
 /// The warnings of [`LyapunovSpectrum::warnings`].
+/// Whether an exponent `e` is resolved from zero: |λ| > 2 × (uncertainty `u` + convergence
+/// `c`), its sign settled (the run's warnings name those that are not).
+pub(crate) fn resolved(e: f64, u: f64, c: f64) -> bool {
+    e.abs() > 2.0 * (u + c)
+}
+
 fn run_warnings(
     exponents: &[f64],
     uncertainty: &[f64],
@@ -271,7 +277,7 @@ fn run_warnings(
         .iter()
         .zip(uncertainty.iter().zip(convergence))
         .enumerate()
-        .filter(|(_, (e, (u, c)))| e.is_nan() || e.abs() <= 2.0 * (**u + **c))
+        .filter(|(_, (e, (u, c)))| !resolved(**e, **u, **c))
         .map(|(k, _)| (k + 1).to_string())
         .collect();
     if !unresolved.is_empty() {

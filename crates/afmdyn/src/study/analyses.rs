@@ -8,7 +8,7 @@ use crate::analysis::continuation::{
     continue_branch, continue_with_switching, Branch, ContinuationSpec,
 };
 use crate::analysis::converge::{mode_convergence, ConvergenceRun};
-use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovSpectrum, MIN_PERIODS};
+use crate::analysis::lyapunov::{lyapunov_spectrum_with, resolved, LyapunovSpectrum, MIN_PERIODS};
 use crate::analysis::observables::{observe_from, ObservableOptions};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
@@ -337,15 +337,15 @@ impl Analysis for ContinuationRequest {
 impl Analysis for LyapunovRequest {
     type Output = LyapunovSpectrum;
     fn convergence(&self, l: &Self::Output) -> Convergence {
-        // an exponent within 2 × (uncertainty + convergence) of zero has not converged to
-        // its sign, nor has any of a run shorter than its minimum
+        // an exponent not resolved from zero has not converged to its sign, nor has any of a
+        // run shorter than its minimum (the spectrum's own warnings)
         let errors = l.uncertainty.iter().zip(&l.convergence);
-        let resolved = l.exponents.iter().zip(errors);
-        let resolved = resolved
-            .filter(|(e, (u, c))| e.abs() > 2.0 * (*u + *c))
+        let settled = l.exponents.iter().zip(errors);
+        let settled = settled
+            .filter(|(e, (u, c))| resolved(**e, **u, **c))
             .count();
-        let resolved = if l.periods < MIN_PERIODS { 0 } else { resolved };
-        Convergence::of("exponents", resolved, l.exponents.len())
+        let settled = if l.periods < MIN_PERIODS { 0 } else { settled };
+        Convergence::of("exponents", settled, l.exponents.len())
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)

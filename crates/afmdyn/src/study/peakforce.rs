@@ -281,6 +281,11 @@ pub(crate) const MAX_FIT_RESIDUAL: f64 = 0.1;
 /// said to be biased.
 pub(crate) const MAX_MODULUS_BIAS: f64 = 0.1;
 
+/// Why a DMT fit reads off the sample's own E* (a single tap's warning and a PeakForce image
+/// material's).
+pub(crate) const BIAS_CAUSE: &str = "the lever's inertia and ringing within the tap, an \
+                                      indentation past the paraboloid's validity";
+
 /// Why a single tap's `modulus_dmt` is missing, or where it is not the sample's modulus
 /// (issue 77): no fit (too few retract points in the band), a fit residual above
 /// [`MAX_FIT_RESIDUAL`], a reading more than [`MAX_MODULUS_BIAS`] off the sample's own E*
@@ -318,8 +323,7 @@ fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> 
         };
         w.push(format!(
             "modulus_dmt reads {ratio:.3} × the sample's own E* (more than {:.0} % off): the DMT \
-             fit of this tap is biased ({other_law}the lever's inertia and ringing within the \
-             tap, an indentation past the paraboloid's validity): compare it against a \
+             fit of this tap is biased ({other_law}{BIAS_CAUSE}): compare it against a \
              calibration sample, not as the sample's modulus",
             MAX_MODULUS_BIAS * 100.0
         ));

@@ -468,11 +468,15 @@ impl PeakForceImageStudy {
             }
         }
         let biased = |r: &&f64| (**r - 1.0).abs() > bound;
+        let cause = super::peakforce::BIAS_CAUSE;
         materials
             .iter()
             .zip(&ratios)
             .filter_map(|(m, r)| {
                 let off: Vec<f64> = r.iter().filter(biased).copied().collect();
+                if off.is_empty() {
+                    return None;
+                }
                 let lo = off.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = off.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 let reads = if hi - lo > 5e-4 * hi {
@@ -480,19 +484,16 @@ impl PeakForceImageStudy {
                 } else {
                     format!("{hi:.3}")
                 };
-                (!off.is_empty()).then(|| {
-                    format!(
-                        "{}: modulus_dmt reads {reads} × the material's own E* on {} of its \
-                     {} single-tap pixels (more than {:.0} % off): the DMT fit is biased there \
-                     (the lever's inertia and ringing within the tap, an indentation past the \
-                     paraboloid's validity): compare it against a calibration sample, not as \
-                     the material's modulus",
-                        m.name,
-                        off.len(),
-                        r.len(),
-                        bound * 100.0
-                    )
-                })
+                Some(format!(
+                    "{}: modulus_dmt reads {reads} × the material's own E* on {} of its {} \
+                     single-tap pixels (more than {:.0} % off): the DMT fit is biased there \
+                     ({cause}): compare it against a calibration sample, not as the material's \
+                     modulus",
+                    m.name,
+                    off.len(),
+                    r.len(),
+                    bound * 100.0
+                ))
             })
             .collect()
     }

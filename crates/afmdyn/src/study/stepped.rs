@@ -160,9 +160,7 @@ macro_rules! present_curve {
 /// not settle within its transient cap counted out.
 fn curve_convergence(c: &SteppedCurve) -> Convergence {
     let points: Vec<_> = c.first.iter().chain(&c.second).collect();
-    Convergence::count("points", &points, |p| {
-        p.average.as_ref().is_none_or(|a| a.settled)
-    })
+    Convergence::count("points", &points, |p| !p.unsettled())
 }
 
 impl Analysis for ApproachRequest {

@@ -298,6 +298,14 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+impl CurvePoint {
+    /// A time-averaged point whose windows still differed at its transient cap ([`average`]):
+    /// not converged (the curve's warnings count them).
+    pub(crate) fn unsettled(&self) -> bool {
+        self.average.as_ref().is_some_and(|a| !a.settled)
+    }
+}
+
 /// One point of a continued branch with its observables.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BranchSample {
@@ -644,11 +652,7 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
         ));
     }
     warnings.extend(contraction::free_decay_warning(first.iter().chain(second)));
-    let unsettled = first
-        .iter()
-        .chain(second)
-        .filter(|p| p.average.as_ref().is_some_and(|a| !a.settled))
-        .count();
+    let unsettled = first.iter().chain(second).filter(|p| p.unsettled()).count();
     if unsettled > 0 {
         warnings.push(format!(
             "{unsettled} time-averaged point(s) did not settle within their transient cap (their \
