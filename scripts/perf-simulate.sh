@@ -3,7 +3,8 @@
 # drive period of `afmdyn simulate --periods 20000` (default parameters, N = 3, linear law, exact
 # propagator) with --files none (the summary only: energy balance, sections, events) and with the
 # default files (200 samples per period to NPY, events, sections, energy, plots), best of 5, against
-# the engine alone (`period_cost`: `advance` over the same parameters, best of 9).
+# the engine alone (`period_cost`: `advance` over the same parameters, best of 9); and the cost
+# of the energy-balance audit (`--energy-balance`, off by default) per law, --files none, best of 5.
 # Usage: bash scripts/perf-simulate.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,6 +27,14 @@ best() { # command... -> best wall seconds of 5
 P=20000
 none=$(best $A simulate --periods $P --files none)
 files=$(best $A simulate --periods $P --out "$tmp/out")
+audit=()
+for run in "linear 300000" "linear 30000 --modes 10" "hertz 60000" "dmt 30000" "jkr 3000"; do
+  set -- $run
+  law=$1 n=$2; shift 2
+  off=$(best $A simulate --contact-law "$law" --periods "$n" "$@" --files none)
+  on=$(best $A simulate --contact-law "$law" --periods "$n" "$@" --files none --energy-balance)
+  audit+=("$law${*:+ ($*)}|$n|$off|$on")
+done
 engine=$(for _ in 1 2 3 4 5 6 7 8 9; do $X linear 3 2000 advance | awk '{print $6}'; done | sort -g | head -1)
 section=$(mktemp)
 {
@@ -42,6 +51,15 @@ for name, t in [("`simulate --files none`", none), ("`simulate` (default files, 
 PY
   echo ""
   echo "\`afmdyn simulate --periods $P\`, default parameters (N = 3, linear law, Ω = 2.6), best of 5; the engine best of 9."
+  echo ""
+  echo "The energy-balance audit (\`--energy-balance\`, Python \`energy_balance=True\`; off by default), \`--files none\`, best of 5:"
+  echo ""
+  echo "| law | periods | without | with | share of the audited run |"
+  echo "|---|---|---|---|---|"
+  for a in "${audit[@]}"; do
+    IFS='|' read -r law n off on <<< "$a"
+    python3 -c "off, on = $off, $on; print(f'| $law | $n | {off:.2f} s | {on:.2f} s | {100 * (on - off) / on:.0f} % |')"
+  done
   echo "<!-- simulate:end -->"
 } > "$section"
 python3 scripts/doc_section.py simulate "$section" "Recording a run: afmdyn simulate"

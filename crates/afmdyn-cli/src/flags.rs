@@ -173,6 +173,9 @@ pub struct SimulateFlags {
     /// `--samples-per-period`: the request's `samples_per_period`.
     #[arg(long, default_value = "200", help = "Samples per drive period, 1..=100000.")]
     pub samples_per_period: usize,
+    /// `--energy-balance`: the request's `energy_balance`.
+    #[arg(long, help = "Audit the energy balance of every drive period (energy.csv, the series' energy_* variables and the summary's energy_residual, whose residual checks the integration); off by default, as it takes a quarter to a half of the run's time (docs/performance.md).")]
+    pub energy_balance: bool,
     /// The flags of the nested `integrator`.
     #[command(flatten)]
     pub integrator: IntegratorFlags,
@@ -182,6 +185,7 @@ impl SimulateFlags {
     /// The [`SimulateRequest`] of these flags (the library validates it).
     pub fn request(&self, initial: Option<Vec<f64>>) -> SimulateRequest {
         SimulateRequest {
+            energy_balance: self.energy_balance,
             initial,
             integrator: self.integrator.request(),
             periods: self.periods,

@@ -147,6 +147,9 @@ fn simulate_writes_series_events_section_and_plots() {
     ]));
     assert!(doc["switchings"].as_u64().unwrap() >= 6);
     assert_eq!(doc["warnings"], serde_json::json!([]), "an accurate run");
+    // the energy balance is audited only when asked for (`--energy-balance`)
+    assert!(doc["energy_residual"].is_null());
+    assert!(!out.join("energy.csv").exists());
     assert_eq!(doc["body_contact"], false);
     assert_eq!(doc["final"]["a"].as_array().unwrap().len(), 3);
     let t = doc["tau_end"].as_f64().unwrap();
@@ -162,7 +165,6 @@ fn simulate_writes_series_events_section_and_plots() {
         "timeseries.npy",
         "events.csv",
         "poincare.csv",
-        "energy.csv",
         "tip.png",
         "tip.svg",
         "phase.png",

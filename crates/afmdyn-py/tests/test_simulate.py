@@ -15,7 +15,7 @@ import afmdyn
 @pytest.fixture(scope="module")
 def reference(cli, tmp_path_factory):
     out = tmp_path_factory.mktemp("simulate")
-    args = "simulate --periods 20 --transient 10 --omega 2.8 --json --out"
+    args = "simulate --periods 20 --transient 10 --omega 2.8 --energy-balance --json --out"
     run = cli(*args.split(), out)
     assert run.returncode == 0, run.stderr
     return out, run.stdout
@@ -23,7 +23,7 @@ def reference(cli, tmp_path_factory):
 
 def test_equals_the_command_lines_output_files(reference):
     out, stdout = reference
-    ds = afmdyn.simulate(periods=20, transient=10, omega=2.8)
+    ds = afmdyn.simulate(periods=20, transient=10, omega=2.8, energy_balance=True)
     import json
 
     cli_doc = json.loads(stdout)
@@ -87,7 +87,7 @@ def test_dims_dtypes_units_and_no_copies():
 
 def test_eq8_and_the_contact_force_hold_on_the_samples():
     p = afmdyn.Params(omega=2.8, gap=0.05)
-    ds = afmdyn.simulate(p, periods=10, transient=5)
+    ds = afmdyn.simulate(p, periods=10, transient=5, energy_balance=True)
     tau = ds.tau.values
     v_t = ds.w_tip.values + p.alpha2 * np.sin(p.omega * tau) + p.alpha5
     np.testing.assert_allclose(ds.v_t.values, v_t, rtol=0, atol=1e-14)

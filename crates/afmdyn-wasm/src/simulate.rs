@@ -31,7 +31,7 @@
 //!
 //!   Besides: `event_tau`, `event_to_contact`, `event_v_t_dot` (the switchings), `section_tau`,
 //!   `section_v_t`, `section_w_tip`, `section_w_tip_dot`, `section_state` (the stroboscopic
-//!   section τ = 2πk/Ω), the energy balance per period (`energy_tau0`, `energy_start`,
+//!   section τ = 2πk/Ω), with `energy_balance` the energy balance per period (`energy_tau0`, `energy_start`,
 //!   `energy_end`, `base_work`, `beam_dissipation`, `contact_dissipation`,
 //!   `energy_residual`), `spectrum` over `frequency` (the amplitude spectrum of W(1,τ)), and
 //!   the coordinates `mode` and `component`.

@@ -216,6 +216,7 @@ PeakForceSweep = TypedDict(
 SimulateRequest = TypedDict(
     "SimulateRequest",
     {
+        "energy_balance": bool,  # default false
         "initial": Optional[List[float]],  # default null
         "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "periods": Optional[float],  # default null

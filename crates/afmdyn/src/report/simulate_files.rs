@@ -6,7 +6,7 @@
 //!   ȧ_1…ȧ_N), with `timeseries.npy.json` describing them;
 //! - `events.csv`: time, from, to, dV_T/dτ of every switching;
 //! - `poincare.csv`: time, V_T, W(1,τ), ∂W/∂τ at the stroboscopic section τ = 2πk/Ω;
-//! - `energy.csv`: the energy balance of every complete drive period (start, stored energy at
+//! - `energy.csv` (when asked for): the energy balance of every complete drive period (start, stored energy at
 //!   its start and end, base work, beam and contact dissipation, residual, end).
 //!
 //! Values are in the units of a [`SeriesUnits`]: the model's, or SI with a probe. Every file is
@@ -39,7 +39,7 @@ pub(crate) struct SeriesFiles {
     csv: Option<CsvStream>,
     events: CsvStream,
     poincare: CsvStream,
-    energy: CsvStream,
+    energy: Option<CsvStream>,
     /// The samples converted to `su`'s units, and CSV lines: reused from chunk to chunk.
     converted: Vec<f64>,
     lines: Vec<u8>,
@@ -83,7 +83,8 @@ fn region(r: Region) -> &'static str {
 }
 
 impl SeriesFiles {
-    /// Open the files of an `n`-mode run in `dir` (`timeseries.csv` only with `csv`).
+    /// Open the files of an `n`-mode run in `dir` (`timeseries.csv` only with `csv`,
+    /// `energy.csv` only with `energy`).
     ///
     /// # Errors
     /// [`FileError`] naming a file that cannot be created.
@@ -92,6 +93,7 @@ impl SeriesFiles {
         n: usize,
         su: SeriesUnits,
         csv: bool,
+        energy: bool,
     ) -> Result<Self, FileError> {
         let columns = series_columns(n, &su);
         let names = su.names();
@@ -116,19 +118,22 @@ impl SeriesFiles {
                 &dir.join("poincare.csv"),
                 &[names.time, "v_t", "w_tip", "w_tip_dot"],
             )?,
-            energy: csv_stream(
-                &dir.join("energy.csv"),
-                &[
-                    time[0],
-                    "e_start",
-                    "e_end",
-                    "base_work",
-                    "beam_dissipation",
-                    "contact_dissipation",
-                    "residual",
-                    time[1],
-                ],
-            )?,
+            energy: match energy {
+                true => Some(csv_stream(
+                    &dir.join("energy.csv"),
+                    &[
+                        time[0],
+                        "e_start",
+                        "e_end",
+                        "base_work",
+                        "beam_dissipation",
+                        "contact_dissipation",
+                        "residual",
+                        time[1],
+                    ],
+                )?),
+                false => None,
+            },
             su,
             converted: Vec::new(),
             lines: Vec::new(),
@@ -188,6 +193,9 @@ impl SeriesFiles {
             );
         }
         csv_lines(&mut self.poincare, lines)?;
+        let Some(energy) = self.energy.as_mut() else {
+            return Ok(());
+        };
         lines.clear();
         let period = model.period();
         for e in c.energy() {
@@ -208,7 +216,7 @@ impl SeriesFiles {
                 .map(Field::Num),
             );
         }
-        csv_lines(&mut self.energy, lines)
+        csv_lines(energy, lines)
     }
 
     /// Finish every file (renamed into place, `timeseries.npy.json` written).
@@ -222,6 +230,6 @@ impl SeriesFiles {
         }
         csv_finish(self.events)?;
         csv_finish(self.poincare)?;
-        csv_finish(self.energy)
+        self.energy.map_or(Ok(()), csv_finish)
     }
 }

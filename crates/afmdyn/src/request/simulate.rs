@@ -39,6 +39,11 @@ pub struct SimulateRequest {
         schemars(extend("x-constants" = { "MAX_SAMPLES_PER_PERIOD": MAX_SAMPLES_PER_PERIOD }))
     )]
     pub samples_per_period: usize,
+    /// Audit the energy balance of every drive period (`energy.csv`, the series' `energy_*`
+    /// variables and the summary's `energy_residual`, whose residual checks the integration);
+    /// off by default, as it takes a quarter to a half of the run's time (`docs/performance.md`).
+    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+    pub energy_balance: bool,
     /// The integrator.
     #[serde(flatten)]
     pub integrator: IntegratorRequest,
@@ -52,6 +57,7 @@ impl Default for SimulateRequest {
             transient: 0.0,
             initial: None,
             samples_per_period: 200,
+            energy_balance: false,
             integrator: IntegratorRequest::default(),
         }
     }

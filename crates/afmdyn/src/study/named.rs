@@ -81,7 +81,11 @@ fn simulate(request: &SimulateRequest, model: &Resolved) -> Result<Outcome, SimE
     let m = CantileverModel::new(p)?;
     let (tr, integrator) = request.record_whole(&m, &span)?;
     let layout = report::simulate_layout(&m, &tr, &su, request.samples_per_period);
-    let mut document = report::with_si(report::simulate(&m, &tr), model.probe.as_ref(), p);
+    let mut document = report::with_si(
+        report::simulate(&m, &tr, request.energy_balance),
+        model.probe.as_ref(),
+        p,
+    );
     // a trajectory from its start, as the streamed run's (`SimulateStream`)
     report::Convergence::exact("trajectory").write_into(&mut document);
     let facts = serde_json::json!({

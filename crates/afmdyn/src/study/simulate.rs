@@ -11,7 +11,7 @@ use crate::trajectory::{record, RecordSpec, Trajectory};
 impl SimulateRequest {
     /// Record the run of `model` over `span` (validated, [`SimulateRequest::validate_in_memory`])
     /// whole in memory ([`crate::trajectory::record`]: samples, switchings, sections, the energy
-    /// balance per period and the body-contact check), from the request's initial state (rest
+    /// balance per period when asked and the body-contact check), from the request's initial state (rest
     /// when none): the trajectory and the integrator's name.
     ///
     /// # Errors
@@ -27,7 +27,7 @@ impl SimulateRequest {
             transient_periods: self.transient,
             record_tau: span.record_tau,
             samples_per_period: self.samples_per_period,
-            energy: true,
+            energy: self.energy_balance,
             body_contact: true,
         };
         let tr = record(integ.as_mut(), &spec)?;

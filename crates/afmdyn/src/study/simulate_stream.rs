@@ -48,7 +48,8 @@ pub struct SimulateRecording {
 impl Analysis for SimulateStream {
     type Output = SimulateRecording;
     fn convergence(&self, _: &SimulateRecording) -> Convergence {
-        // a trajectory from its start, nothing iterated (its energy audit warns on its own)
+        // a trajectory from its start, nothing iterated (its energy audit, when asked, warns on
+        // its own)
         Convergence::exact("trajectory")
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
@@ -62,7 +63,13 @@ impl Analysis for SimulateStream {
             Some(dir) => {
                 // what a run killed outright left of these files
                 crate::io::dir_lock::remove_partials_in(dir, &SERIES_FILES)?;
-                Some(SeriesFiles::create(dir, p.modes, su, self.csv)?)
+                Some(SeriesFiles::create(
+                    dir,
+                    p.modes,
+                    su,
+                    self.csv,
+                    self.request.energy_balance,
+                )?)
             }
             None => None,
         };
@@ -74,6 +81,7 @@ impl Analysis for SimulateStream {
             transient_periods: self.request.transient,
             record_tau: span.record_tau,
             samples_per_period: if files.is_some() { spp } else { 0 },
+            energy: self.request.energy_balance,
             chunk_periods: self.chunk_periods,
         };
         progress.add_total(span.total_periods.ceil() as usize);
@@ -111,7 +119,7 @@ impl Analysis for SimulateStream {
                 switchings: summary.switchings,
                 body_contact: summary.body_contact,
                 poincare_points: summary.sections,
-                energy_residual: (summary.residual, summary.relative),
+                energy_residual: spec.energy.then_some((summary.residual, summary.relative)),
             },
             spectrum: spectrum.into(),
             plots,
@@ -324,10 +332,12 @@ pub(crate) fn simulate(
             nm(m.v_t(tau_end, zf))
         ));
     }
-    let (residual, relative) = r.summary.energy_residual;
-    s.line(format!(
-        "energy balance: largest per-period residual {residual:.3e} ({relative:.1e} relative)"
-    ));
+    s.line(match r.summary.energy_residual {
+        Some((residual, relative)) => format!(
+            "energy balance: largest per-period residual {residual:.3e} ({relative:.1e} relative)"
+        ),
+        None => "energy balance: not audited (--energy-balance)".into(),
+    });
     if run.dir.is_none() {
         s.line("no files written (--files none)");
         return Ok(s);

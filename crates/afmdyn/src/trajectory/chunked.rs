@@ -24,6 +24,8 @@ pub(crate) struct ChunkedSpec {
     pub record_tau: f64,
     /// Samples per drive period (0: none kept).
     pub samples_per_period: usize,
+    /// Audit the energy balance of every period ([`RecordSpec::energy`]).
+    pub energy: bool,
     /// Drive periods per chunk; `None`: [`CHUNK_SAMPLES`] samples, or
     /// [`CHUNK_PERIODS_WITHOUT_SAMPLES`] periods without samples.
     pub chunk_periods: Option<usize>,
@@ -97,7 +99,7 @@ impl ChunkedSummary {
 }
 
 /// Record `spec` from `integ`'s current state in chunks, calling `each` on every chunk as it
-/// is finished (energy and body-contact check on), and `progress` with the drive periods done
+/// is finished (the body-contact check on, the energy balance as `spec` asks), and `progress` with the drive periods done
 /// (transient included).
 ///
 /// Chunks end on stroboscopic sections τ = 2πk/Ω (so that no energy period is split) when the
@@ -156,7 +158,7 @@ pub(crate) fn record_chunked<E: From<SimError>>(
                     (target - now).max(0.0)
                 },
                 samples_per_period: spp,
-                energy: true,
+                energy: spec.energy,
                 body_contact: true,
             },
             &mut rows,
@@ -239,6 +241,7 @@ mod tests {
                     transient_periods: 2.0,
                     record_tau: 10.0 * period,
                     samples_per_period: 40,
+                    energy: true,
                     chunk_periods: Some(chunk_periods),
                 },
                 |c| {
