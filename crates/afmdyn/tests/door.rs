@@ -429,6 +429,10 @@ fn every_request_declares_a_cost_that_bounds_its_run() {
                     cost.bytes
                 ));
             }
+            // every request that computes declares its work (the modes' eigenproblem is none)
+            if cost.work <= 0.0 && name != "modes" {
+                over.push(format!("{name}: no work declared"));
+            }
             if took > 2.0 + 1e-3 * cost.work {
                 over.push(format!(
                     "{name}: {took:.1} s for a declared {:.3e} mode-periods",

@@ -4,10 +4,13 @@
 //! cost. Everything is SI (m, N, Pa, J/m²); a probe file is needed (the lever's spring
 //! constant, the start values and the held parameters).
 
+use super::costs::OPERATION_WORK;
+use super::fit_dynamic::fit_evaluations;
 use super::fit_result::MIN_FIT_ROWS;
 use super::limits::Cost;
 use super::run::{Request, Resolved};
 use crate::analysis::fit::force_curve::{self, Segment, CONTACT_POINT, YOUNGS_MODULUS};
+use crate::analysis::fit::profile::MAX_GRID_REFITS;
 use crate::analysis::fit::sls_curve;
 use crate::contact::LawKind;
 use crate::error::SimError;
@@ -386,6 +389,7 @@ impl Request for FitRequest {
         // columns), the residuals, the document's numbers, the outcome's arrays and the front
         // end's table and figures: 900 bytes (the library's run 343 at 1 000 to 10⁶ rows,
         // `tests/door.rs`; the command line's heap 783 and its resident set 818 at 10⁶ rows)
+        let (n, walk) = (self.fit.len().max(5), self.profiles.unwrap_or(true));
         let rows = if self.data.is_some() {
             MAX_FIT_ROWS
         } else {
@@ -393,7 +397,9 @@ impl Request for FitRequest {
         } as f64;
         Ok(Cost {
             bytes: super::costs::MODEL_BYTES + rows * 900.0,
-            work: 0.0,
+            // each evaluation a row's model and Jacobian (of at most five parameters: SLS's
+            // three, the contact point and the baseline), the profiles walked on a grid
+            work: rows * OPERATION_WORK * fit_evaluations(n, walk.then_some(MAX_GRID_REFITS)),
         })
     }
 }

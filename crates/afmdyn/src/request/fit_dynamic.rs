@@ -266,6 +266,19 @@ pub(crate) fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) ->
     names
 }
 
+/// The most model evaluations of a fit of `fitted` parameters: the minimiser's
+/// ([`crate::analysis::fit::least_squares::max_evaluations`]), the final χ² and Jacobian, and
+/// with profiles walked by at most `refits` refits a side (of up to `MAX_PROFILED` parameters)
+/// each refit's (at `REFIT_PATIENCE`).
+pub(crate) fn fit_evaluations(fitted: usize, refits: Option<usize>) -> f64 {
+    use crate::analysis::fit::estimates::MAX_PROFILED;
+    use crate::analysis::fit::least_squares::{max_evaluations, PATIENCE};
+    use crate::analysis::fit::profile::REFIT_PATIENCE;
+    let refits = (fitted.min(MAX_PROFILED) * 2 * refits.unwrap_or(0)) as f64;
+    let refit = max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
+    max_evaluations(fitted, PATIENCE) as f64 + 2.0 + refits * refit
+}
+
 /// The declared cost of a dynamic fit of `rows` rows fitting `fitted` parameters on
 /// `params` (the probe's model), with profiles when `profiles`: the worst case of its
 /// evaluations, each one stepped approach of the rows (`super::costs::stepped_cost`, one
@@ -285,9 +298,6 @@ pub(crate) fn cost(
     profiles: bool,
     params: &crate::params::Params,
 ) -> Result<super::limits::Cost, SimError> {
-    use crate::analysis::fit::estimates::MAX_PROFILED;
-    use crate::analysis::fit::least_squares::{max_evaluations, PATIENCE};
-    use crate::analysis::fit::profile::REFIT_PATIENCE;
     use crate::analysis::fit::start::Z_OFFSET_GRID;
     let mut spec =
         crate::analysis::stepped::SteppedSpec::new(*params, crate::params::SweepParam::Alpha5, {
@@ -296,11 +306,7 @@ pub(crate) fn cost(
     spec.branches = false;
     let approach = super::costs::stepped_cost(&spec)?;
     let grid = (2 * Z_OFFSET_GRID + 1) as f64;
-    let mut evaluations = grid + max_evaluations(fitted, PATIENCE) as f64 + 2.0;
-    if profiles {
-        let refits = (fitted.min(MAX_PROFILED) * 2 * MAX_SECANT_STEPS) as f64;
-        evaluations += refits * max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
-    }
+    let evaluations = grid + fit_evaluations(fitted, profiles.then_some(MAX_SECANT_STEPS));
     let cost = super::limits::Cost {
         bytes: approach.bytes + rows as f64 * 8.0 * 64.0,
         work: evaluations * approach.work,

@@ -60,25 +60,15 @@ impl AmData {
     /// amplitude `a0` (10⁻³ to 3 times it), the largest |Δf| against the resonance `f0`
     /// (10⁻⁶ f₀ to half of it).
     pub(crate) fn unit_slips(&self, a0: f64, f0: f64) -> Vec<String> {
-        use super::quantity::{largest_magnitude, span, unit_slip, Dim};
+        use super::quantity::{largest_magnitude, shift_slip, span, unit_slip, Dim};
         let amplitude = |name, v: &Option<Vec<f64>>| {
             let a = v.as_deref().map_or(0.0, largest_magnitude);
             unit_slip(name, "the largest", a, Dim::Length, (1e-3 * a0, 3.0 * a0))
         };
-        let shift = self
-            .frequency_shift
-            .as_deref()
-            .map_or(0.0, largest_magnitude);
         [
             unit_slip("z", "the span", span(&self.z), Dim::Length, (1e-11, 1e-4)),
             amplitude("amplitude", &self.amplitude),
-            unit_slip(
-                "frequency_shift",
-                "the largest |Δf|",
-                shift,
-                Dim::Frequency,
-                (1e-6 * f0, 0.5 * f0),
-            ),
+            shift_slip(self.frequency_shift.as_deref().unwrap_or(&[]), f0),
         ]
         .into_iter()
         .flatten()

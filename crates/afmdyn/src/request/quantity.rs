@@ -75,6 +75,18 @@ const UNITS: [(&str, i32, Dim); 15] = [
     ("N", 0, Dim::Force),
 ];
 
+/// [`unit_slip`] of a frequency-shift column: its largest |Δf| against the resonance `f0`
+/// (10⁻⁶ f₀ to half of it).
+pub(crate) fn shift_slip(shift: &[f64], f0: f64) -> Option<String> {
+    unit_slip(
+        "frequency_shift",
+        "the largest |Δf|",
+        largest_magnitude(shift),
+        Dim::Frequency,
+        (1e-6 * f0, 0.5 * f0),
+    )
+}
+
 /// A data column checked against the probe (issue 77 item 4): `magnitude`, a positive size of
 /// the column (its span, or its largest |value|), against the `typical` range (lo, hi) in SI
 /// that the probe gives it; outside, the warning names the column, the range and the unit the

@@ -28,12 +28,12 @@
 //! lever oscillates by more than 10 µm (a thousand times the tapping amplitudes) or by less
 //! than a picometre (its thermal motion), resonates below 1 kHz or above 10 GHz, or has a stiffness outside 10⁻⁶–10⁹ N/m.
 
-use super::costs::MODEL_BYTES;
+use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::limits::Cost;
 use super::run::{Request, Resolved};
-use crate::analysis::reconstruct::{Method, ShiftCurve};
+use crate::analysis::reconstruct::{Method, ShiftCurve, NEAR_FIELD};
 use crate::analysis::reconstruct_am::AmCurve;
-use crate::analysis::reconstruct_exact::{check_exact, exact_weights};
+use crate::analysis::reconstruct_exact::{check_exact, exact_weights, EXACT_MAX_ITERATIONS};
 use crate::error::{number, SimError};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -120,7 +120,7 @@ pub(crate) const DECAYED: f64 = 0.01;
 /// span against the range of a tip–sample distance (10 pm to 10 µm), the largest |Δf|
 /// against the resonance f₀ (from 10⁻⁶ f₀ to half of it).
 pub(crate) fn shift_curve_slips(distance: &[f64], shift: &[f64], f0: f64) -> Vec<String> {
-    use super::quantity::{largest_magnitude, span, unit_slip, Dim};
+    use super::quantity::{shift_slip, span, unit_slip, Dim};
     [
         unit_slip(
             "distance",
@@ -129,13 +129,7 @@ pub(crate) fn shift_curve_slips(distance: &[f64], shift: &[f64], f0: f64) -> Vec
             Dim::Length,
             (1e-11, 1e-5),
         ),
-        unit_slip(
-            "frequency_shift",
-            "the largest |Δf|",
-            largest_magnitude(shift),
-            Dim::Frequency,
-            (1e-6 * f0, 0.5 * f0),
-        ),
+        shift_slip(shift, f0),
     ]
     .into_iter()
     .flatten()
@@ -340,22 +334,25 @@ impl Request for ReconstructRequest {
         // document's and the front end's, six of 32-byte JSON values (at 2·10⁶ points the
         // library's run peaked at 464 MB, Sader–Jarvis, and 681 MB, exact, 91 B a point above
         // the columns alone; the command line's resident set at 537 MB and 763 MB)
+        // the work: the operations (OPERATION_WORK) of the FFTs' m log₂ m butterflies, m the
+        // next power of two ≥ 2n, and the near field, or the direct sum's pairs
         let n = self.frequency_shift.len();
-        let curve = self.curve()?;
-        let mut work_bytes = match curve.method()? {
-            Method::Fft { .. } => 3.0 * 16.0 * (2 * n).next_power_of_two() as f64,
-            Method::Direct => 8.0 * n as f64,
+        let (curve, m) = (self.curve()?, (2 * n).next_power_of_two() as f64);
+        let fft = m * m.log2();
+        let (mut work_bytes, mut ops) = match curve.method()? {
+            Method::Fft { .. } => (3.0 * 16.0 * m, 3.0 * fft + (NEAR_FIELD * n) as f64),
+            Method::Direct => (8.0 * n as f64, (n * n) as f64 / 2.0),
         };
         if self.inversion == FmInversion::Exact {
             // the forward relation's kernel and buffer (FFT of at most the next power of two
-            // ≥ 2n) or its rows' weights, and the iterate's five columns
-            work_bytes += 2.0 * 16.0 * (2 * n).next_power_of_two() as f64
-                + 8.0 * exact_weights(&curve) as f64
-                + 5.0 * 8.0 * n as f64;
+            // ≥ 2n) or its rows' weights, and the iterate's five columns; at every step
+            let weights = exact_weights(&curve) as f64;
+            work_bytes += 2.0 * 16.0 * m + 8.0 * weights + 5.0 * 8.0 * n as f64;
+            ops += EXACT_MAX_ITERATIONS as f64 * (2.0 * fft + weights);
         }
         Ok(Cost {
             bytes: MODEL_BYTES + work_bytes + (5.0 * 8.0 + 6.0 * 32.0) * n as f64,
-            work: 0.0,
+            work: OPERATION_WORK * ops,
         })
     }
 }
@@ -374,11 +371,11 @@ impl Request for AmReconstruction {
     }
     fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
         // no integration; the curve's and the inversion's columns (its weights are summed
-        // row by row, at most a documented number of them)
+        // row by row, at most one a pair of points)
         let n = am_curve_from_approach(&self.0)?.z_c.len() as f64;
         Ok(Cost {
             bytes: MODEL_BYTES + 12.0 * 8.0 * n,
-            work: 0.0,
+            work: OPERATION_WORK * n * n,
         })
     }
 }

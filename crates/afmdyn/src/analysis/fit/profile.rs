@@ -31,6 +31,9 @@ pub(crate) const MAX_PROFILE_STEPS: usize = 30;
 /// Bisections refining a crossing of [`DELTA_CHI2_95`] between two grid points.
 const BISECTIONS: usize = 5;
 
+/// The most refits on each side of the grid walk: its points and a crossing's bisections.
+pub(crate) const MAX_GRID_REFITS: usize = MAX_PROFILE_STEPS + BISECTIONS;
+
 /// The most refits on each side of the secant walk of the dynamic fit: with the first step at
 /// one standard error and at most doubling, 6 refits reach 32 SE from the estimate before the
 /// profile is called flat.
