@@ -314,11 +314,10 @@ impl Analysis for FitRequest {
         at: crate::request::Presenting<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = at.document.clone();
-        let to = crate::report::present::Destination::default();
         Ok(crate::report::present::fit::fit(
             &mut document,
             at.units,
-            to,
+            at.to,
         ))
     }
 }
