@@ -10,10 +10,14 @@ import afmdyn
 
 def test_a_caveat_is_an_afmdyn_warning_and_in_the_summary() -> None:
     # 400 RK4 steps per period do not close the energy balance to 1e-6 (the coarse run of
-    # test_simulate.py): the answer is returned, with a warning
+    # test_simulate.py; audited when asked for): the answer is returned, with a warning
     with pytest.warns(afmdyn.AfmdynWarning, match="energy balance") as caught:
         a = afmdyn.simulate(
-            periods=2, integrator="rk4", steps_per_period=400, samples_per_period=20
+            periods=2,
+            integrator="rk4",
+            steps_per_period=400,
+            samples_per_period=20,
+            energy_balance=True,
         )
     lines = afmdyn.summary(a)["warnings"]
     assert lines and [str(w.message) for w in caught] == lines
