@@ -129,6 +129,21 @@ fn bimodal_refuses_a_single_frequency_drive_and_bad_arrays() {
     }
 }
 
+/// A bimodal curve over its budget is refused by its own name, not the approach's it wraps.
+#[test]
+fn a_bimodal_curve_over_budget_is_refused_as_bimodal() {
+    let args = [
+        "bimodal", "--probe", PROBE, "--points", "100000", "--traces", "20",
+    ];
+    let out = afmdyn(&[&args[..], &["--files", "none"]].concat());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("afmdyn: bimodal: a peak memory of"),
+        "{err}"
+    );
+}
+
 /// The doc's `time_average.<sweep>.<k>` as rows of numbers (one per point).
 fn estimates(doc: &serde_json::Value, sweep: &str, k: &str) -> Vec<Vec<f64>> {
     doc["time_average"][sweep][k]

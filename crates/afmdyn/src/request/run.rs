@@ -430,7 +430,7 @@ impl Request for Bimodal {
         self.0.validate(model)
     }
     fn name(&self) -> &'static str {
-        self.0.name()
+        "bimodal"
     }
     fn probe_needs(&self) -> crate::probe::ProbeNeeds {
         crate::probe::ProbeNeeds::Tapping
