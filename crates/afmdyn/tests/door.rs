@@ -444,6 +444,53 @@ fn every_request_declares_a_cost_that_bounds_its_run() {
     assert!(over.is_empty(), "{over:#?}");
 }
 
+/// The unconverged parts are counted by kind: a chart's cells and a global continuation's
+/// values still settling after a transient cap of 3 drive periods (the paper's default model,
+/// Q ≈ 10: ~Q periods to settle) are not settled, as the surfaces' own warnings count them.
+#[test]
+fn a_transient_cap_too_short_leaves_parts_unconverged() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::{ChartRequest, ModelSpec, SteadyRequest};
+    use serde_json::json;
+    let model = model(None);
+    let keywords = json!({"param": "omega", "from": 2.5, "to": 2.7, "steps": 2, "samples": 3,
+                          "max_periods": 3});
+    let global = request("global_continuation", &keywords).run(&model, &Progress::new());
+    let chart = ChartRequest {
+        x_steps: 3,
+        y_steps: 3,
+        starts: 2,
+        steady: SteadyRequest {
+            max_periods: Some(3),
+            ..SteadyRequest::default()
+        },
+        ..ChartRequest::default()
+    }
+    .chart(ModelSpec::default(), Params::default(), None)
+    .unwrap();
+    let chart = afmdyn::request::run(&chart, &model, &Progress::new());
+    for (name, doc) in [
+        ("global continuation", global.unwrap().document),
+        ("chart", chart.unwrap().json),
+    ] {
+        let c = &doc["converged"];
+        let (settled, of) = (c["settled"].as_u64().unwrap(), c["of"].as_u64().unwrap());
+        assert!(settled < of, "{name}: {c}");
+        let first = doc["warnings"][0].as_str().unwrap_or("");
+        let says = format!("convergence: {} of {of} ", of - settled);
+        assert!(first.starts_with(&says), "{name}: {first}");
+        if name == "chart" {
+            // the chart's own count of cells still settling (λ₁ ≤ 0, no period)
+            let own = format!("{} of {of} cells have a nonperiodic motion", of - settled);
+            assert!(
+                doc["warnings"].to_string().contains(&own),
+                "{}",
+                doc["warnings"]
+            );
+        }
+    }
+}
+
 /// Every document of the door states its convergence (`converged`: `settled` of `of` parts,
 /// `all` when they are equal), and a partial result's warnings begin by saying so.
 fn converged_is_stated(name: &str, doc: &serde_json::Value) {

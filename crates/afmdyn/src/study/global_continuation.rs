@@ -99,9 +99,12 @@ impl ContinuationStudy {
 
 impl Analysis for GlobalContinuationRequest {
     type Output = Vec<ContinuationStep>;
+    /// A value's census converged: it found an attractor, no run failed, none is unsettled and
+    /// no caveat was raised (a start still settling at the transient cap, or undecided, λ₁ ≈ 0).
     fn convergence(&self, steps: &Self::Output) -> Convergence {
         Convergence::count("values", steps, |s| {
-            s.failures.is_empty() && !s.attractors.iter().any(|(_, a)| a.unsettled())
+            let unsettled = s.attractors.iter().any(|(_, a)| a.unsettled());
+            !s.attractors.is_empty() && s.failures.is_empty() && s.warnings.is_empty() && !unsettled
         })
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
