@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The synthetic force curve of docs/afm-workflow.md ("From data to properties"):
+"""The synthetic force curve of docs/tutorials/fitting-force-curves.md:
 examples/force-curve-hertz.csv, an approach and retract on a Hertz sample with known truth.
 
 A 10 µm bead (R = 5 µm) on a lever of k = 0.05 N/m indents a sample of E = 5 kPa, ν = 0.5

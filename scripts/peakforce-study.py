@@ -11,7 +11,7 @@
 2. The bias of `modulus_dmt` (the PF-QNM DMT fit of the retract curve, on the force the
    instrument measures, k x deflection) at f0/f_m = 100 and 10 on the same lever (Q = 100)
    over DMT, JKR and SLS samples: a table between the markers `peakforce-bias` in
-   docs/afm-workflow.md, and docs/figures/peakforce/bias.json.
+   docs/tutorials/peakforce.md, and docs/figures/peakforce/bias.json.
 
 Every number comes from the command line's JSON document (`afmdyn peakforce --json`).
 Usage: cargo build --release -p afmdyn-cli && target/venv-test/bin/python scripts/peakforce-study.py
@@ -197,7 +197,7 @@ def main() -> None:
         f.write(section(table))
     subprocess.run(
         [sys.executable, str(ROOT / "scripts/doc_section.py"), "peakforce-bias", f.name,
-         "PeakForce: the bias of modulus_dmt", str(ROOT / "docs/afm-workflow.md")],
+         "PeakForce: the bias of modulus_dmt", str(ROOT / "docs/tutorials/peakforce.md")],
         check=True,
     )
     os.unlink(f.name)

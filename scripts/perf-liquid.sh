@@ -66,7 +66,7 @@ section=$(mktemp)
     echo "viscoelastic sample ≤ 5 s. The fluid changes the matrices, not the method: the same"
     echo "integrator (Taylor, auto's choice for DMT; adaptive DOP853 for the SLS sample's internal"
     echo "state) and the same continuation as in air; the"
-    echo "higher-mode fraction is √(Σ_{k≥2} A_k²)/A_1 of the free lever's eigenmodes (docs/afm-workflow.md §6e)."
+    echo "higher-mode fraction is √(Σ_{k≥2} A_k²)/A_1 of the free lever's eigenmodes (docs/tutorials/liquids.md)."
     echo "Figures of the SLS curve: docs/figures/approach-water-sls/."
     echo "\`bash scripts/perf-liquid.sh\` on this machine (2 cores; one curve is one chain, so one core)."
     echo "<!-- liquid:end -->"

@@ -1,6 +1,6 @@
 // The off-resonance (PeakForce) tap of `afmdyn peakforce --json` drawn as the instrument shows
 // it: the force–distance curve (approach and retract) and one modulation period against time,
-// with the instrument's channels (issue 61; docs/afm-workflow.md §6g). Data in, figures out:
+// with the instrument's channels (issue 61; docs/tutorials/peakforce.md). Data in, figures out:
 // no numerics here.
 
 const SI = { exponentformat: "SI" };

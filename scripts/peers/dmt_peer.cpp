@@ -1,7 +1,7 @@
 // Compiled DOP853 peer of afmdyn for the point-mass DMT model (issue 26, item 5).
 //
 // The model (afmdyn's point-mass structure with the DMT law, dimensionless: τ = ω₀t, lengths of
-// A₀, forces of k A₀; docs/afm-workflow.md §2–3):
+// A₀, forces of k A₀; docs/getting-started.md, the structural models and SI to groups):
 //
 //   z'' + α3 z' + z = α2 cos Ωτ + F_c(δ, δ̇),   δ = −V_T, δ̇ = −V_T',   V_T = z + α5
 //

@@ -18,7 +18,7 @@ pub struct ModelArgs {
     #[arg(long, value_name = "FILE.toml")]
     pub config: Option<PathBuf>,
     /// Probe file in SI units (cantilever k, f0, Q or geometry; tip; sample law; drive A0, f;
-    /// see docs/afm-workflow.md): sets every parameter, the flags below override single ones,
+    /// see docs/getting-started.md): sets every parameter, the flags below override single ones,
     /// and JSON output gains an "si" block with the scales and headline values in SI
     #[arg(long, value_name = "PROBE.toml", conflicts_with = "config")]
     pub probe: Option<PathBuf>,
@@ -30,7 +30,7 @@ pub struct ModelArgs {
     #[arg(long, value_name = "NAME", requires = "probe")]
     pub cantilever: Option<String>,
     /// The fluid around the lever, over the probe file's [medium]: water or air (Sader's
-    /// hydrodynamic loading of every mode; docs/afm-workflow.md §6e), or none (no fluid)
+    /// hydrodynamic loading of every mode; docs/tutorials/liquids.md), or none (no fluid)
     #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(long, value_name = "NAME", requires = "probe")]
     pub medium: Option<String>,

@@ -67,7 +67,7 @@ pub struct UnitsArgs {
     )]
     config: Option<PathBuf>,
     /// Probe file (cantilever k, f0, Q or geometry; tip; sample law; drive A0, f; see
-    /// examples/probe-beam-dmt.toml and docs/afm-workflow.md): print its dimensionless set and
+    /// examples/probe-beam-dmt.toml and docs/getting-started.md): print its dimensionless set and
     /// scales
     #[arg(long, value_name = "PROBE.toml")]
     probe: Option<PathBuf>,

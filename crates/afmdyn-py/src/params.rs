@@ -139,7 +139,7 @@ impl PyParams {
 
     /// The dimensionless set of a probe file in SI units (the command line's
     /// ``--probe FILE``: cantilever k, f₀, Q or geometry; tip; sample law; drive A₀, f; see
-    /// ``docs/afm-workflow.md``), also given as TOML text or a dict of its sections; ``**model``
+    /// ``docs/getting-started.md``), also given as TOML text or a dict of its sections; ``**model``
     /// takes what a probe leaves open, as every analysis' ``probe=`` does: ``modes``,
     /// ``restitution``, ``z_c`` (m) and ``drive_frequency`` (Hz); a dimensionless value the
     /// probe sets (``gap``, ``omega``, ``hamaker``, …) is refused naming the probe key or SI

@@ -41,7 +41,7 @@ fn jkr_probe() -> Probe {
 }
 
 /// E* of the probe's tip and sample (Johnson eq. 4.22); the tip is the documented default,
-/// silicon with E = 130 GPa and the paper's ν = 0.27 (docs/afm-workflow.md).
+/// silicon with E = 130 GPa and the paper's ν = 0.27 (docs/getting-started.md).
 fn e_star() -> f64 {
     1.0 / ((1.0 - 0.27f64.powi(2)) / 130e9 + (1.0 - 0.4f64.powi(2)) / 50e6)
 }

@@ -107,7 +107,7 @@ def probe(
     medium: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Read a probe in SI units (the command line's ``--probe FILE``; format and mapping in
-    ``docs/afm-workflow.md``): a file's path, its TOML text or a dict of its sections, with
+    ``docs/getting-started.md``): a file's path, its TOML text or a dict of its sections, with
     ``cantilever`` as ``--cantilever`` and ``medium`` (``"water"``, ``"air"``, ``"none"``) as
     ``--medium``.
 

@@ -427,7 +427,7 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
                   "sample.maxwell_stiffness": "N/m", "sample.relaxation_time": "s", "time": "s",
                   "tip_position": "m", "force": "N",
                   "fit": "N", "residual": "N", "chi2_dof": if o.noise_estimated { "N^2" } else { "1" }},
-        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); ".to_string() + model + "; standard errors from (JᵀWJ)⁻¹ s²; " + intervals_method(o) + " (docs/afm-workflow.md, From data to properties)",
+        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); ".to_string() + model + "; standard errors from (JᵀWJ)⁻¹ s²; " + intervals_method(o) + " (docs/tutorials/fitting-force-curves.md)",
         "warnings": o.warnings,
     });
     if let Some(t) = &r.curve.time {

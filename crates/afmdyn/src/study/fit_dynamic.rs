@@ -344,13 +344,13 @@ pub(crate) fn document(
         (
             "fm",
             "none: z and the frequency shift as measured; z_c = z + z_offset; the amplitude setpoint the probe's free amplitude",
-            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the FM curve the instrument recorded (an ideal PLL and amplitude controller: each row's orbit at the drive frequency and excitation that hold the first harmonic at the probe's free amplitude and the free lever's phase at resonance, followed from row to row as afmdyn fm does, z_c = z + z_offset; Δf = Ω − ω₁), with exact sensitivities: the implicit function theorem on the loop conditions, d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, from the orbits' sensitivities (variational equations extended by the parameters and the drive's α2 and Ω, time rescaled to a fixed phase; ∂x*/∂p = (I − M)⁻¹ ∂P/∂p) (docs/afm-workflow.md, From data to properties)",
+            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the FM curve the instrument recorded (an ideal PLL and amplitude controller: each row's orbit at the drive frequency and excitation that hold the first harmonic at the probe's free amplitude and the free lever's phase at resonance, followed from row to row as afmdyn fm does, z_c = z + z_offset; Δf = Ω − ω₁), with exact sensitivities: the implicit function theorem on the loop conditions, d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, from the orbits' sensitivities (variational equations extended by the parameters and the drive's α2 and Ω, time rescaled to a fixed phase; ∂x*/∂p = (I − M)⁻¹ ∂P/∂p) (docs/tutorials/fitting-dynamic-curves.md)",
         )
     } else {
         (
             "am",
             "none: z, amplitude and phase as measured; z_c = z + z_offset",
-            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/tutorials/fitting-dynamic-curves.md)",
         )
     };
     let method = format!("{}{walk}; {least_squares}", intervals_method(o));

@@ -139,7 +139,7 @@ pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -
         "spring_constant": spring_constant,
         "resonance_frequency": r.omega * hz,
         "units": units,
-        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/afm-workflow.md)",
+        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/tutorials/fm.md)",
         "warnings": warnings(request, model, &frame, curve),
     })
 }

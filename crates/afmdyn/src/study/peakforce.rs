@@ -441,7 +441,7 @@ pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakFor
             "kind": FILTER_KIND,
         })),
         "units": units_block(u.si),
-        "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/afm-workflow.md)",
+        "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/tutorials/peakforce.md)",
         "warnings": warnings,
     })
 }
