@@ -16,7 +16,8 @@ front ends already declare, so that no reference table is written by hand (issue
   ``docs/schema/probe-keys.json`` (written and checked by ``crates/afmdyn/tests/schema.rs``
   from the probe reader, ``probe::ranges::SI_RANGES`` and the law registry ``contact::LAWS``).
 * ``python.md``: the Python API by Sphinx autodoc, one directive per name of ``afmdyn.__all__``
-  (read from the package's sources, not imported), grouped by the module that defines it.
+  and ``afmdyn.dask.__all__`` (read from the package's sources, not imported), grouped by the
+  module that lists it.
 * ``messages.md``: the errors of the library's door (``SimError`` in
   ``crates/afmdyn/src/error.rs``): each variant's message and its doc comment.
 * ``index.md``: the toctree of these pages.
@@ -200,64 +201,81 @@ def commands_pages(snapshot: str) -> Dict[str, str]:
 
 # --- python.md -----------------------------------------------------------------------------
 
-#: the groups of the Python page: the module whose ``__all__`` lists the names, its heading and
-#: its sentence (the modules' own docstrings say the same at more length)
+#: the groups of the Python page: the module whose ``__all__`` lists the names (``follow``: with
+#: the names of the modules its ``__all__`` adds), its heading and its sentence (the modules' own
+#: docstrings say the same at more length)
 PY_GROUPS = [
-    ("_wrappers", "Analyses of the dynamics",
+    ("_wrappers", False, "Analyses of the dynamics",
      "The paper's model: modes, trajectories, steady states, bifurcations, orbits, "
      "continuation, Lyapunov exponents and behaviour charts."),
-    ("_wrappers_afm", "AFM measurements",
+    ("_wrappers_afm", False, "AFM measurements",
      "Observables of a steady state, approach and resonance curves, FM-AFM, PeakForce, fits of "
      "measured curves, images and the force reconstruction."),
-    ("_wrappers_starts", "Studies of random starts",
+    ("_wrappers_starts", False, "Studies of random starts",
      "Coexisting attractors, their basins and their continuation over a parameter."),
-    ("__init__", "Probes, models and results",
+    ("__init__", False, "Probes, models and results",
      "The probe reader, the cantilever library, the model's parameters and the result types."),
+    ("dask", True, "On a Dask cluster (`afmdyn.dask`)",
+     "The studies mapped over a `dask.distributed` cluster, resumable from a Zarr store "
+     "(`pip install \"afmdyn[dask]\"`)."),
 ]
 
 
-def module_all(stem: str) -> List[str]:
-    """The names a module of the package lists in its own ``__all__`` (its first assignment and
-    the literal lists added to it), read from its source."""
+def module_all(stem: str, follow: bool = False) -> List[str]:
+    """The names a module of the package lists in its ``__all__`` (the literal lists assigned
+    or added to it; with ``follow``, also the ``__all__`` of a module added), from its source."""
     tree = ast.parse((PACKAGE / f"{stem}.py").read_text())
     names: List[str] = []
     for node in tree.body:
         target = node.targets[0] if isinstance(node, ast.Assign) else getattr(node, "target", None)
-        if isinstance(target, ast.Name) and target.id == "__all__" and isinstance(
-                node.value, ast.List):  # type: ignore[union-attr]
-            names += [ast.literal_eval(e) for e in node.value.elts]  # type: ignore[union-attr]
+        if not (isinstance(target, ast.Name) and target.id == "__all__"):
+            continue
+        value = node.value  # type: ignore[union-attr]
+        if isinstance(value, ast.List):
+            names += [ast.literal_eval(e) for e in value.elts]
+        elif follow and isinstance(value, ast.Attribute) and isinstance(value.value, ast.Name):
+            names += module_all(value.value.id, follow)
     return names
 
 
-def class_names() -> set:
-    """The names of ``afmdyn.__all__`` that are classes (those of the package's sources and of
-    the compiled module's stub)."""
-    out = set()
-    for path in PACKAGE.glob("*.py*"):
-        for node in ast.walk(ast.parse(path.read_text())):
+def kinds() -> Dict[str, str]:
+    """The autodoc directive of each name the package's sources (and the compiled module's
+    stub) define: ``autoclass`` for a class or a ``TypedDict``, ``autodata`` for a module-level
+    constant, ``autofunction`` else."""
+    out: Dict[str, str] = {}
+    for path in sorted(PACKAGE.glob("*.py*")):
+        tree = ast.parse(path.read_text())
+        for node in tree.body:
+            if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name):
+                typed = isinstance(node.value, ast.Call) and getattr(
+                    node.value.func, "id", "") == "TypedDict"
+                name = node.targets[0].id
+                out.setdefault(name, "autoclass" if typed else "autodata")
+                if typed:
+                    out[name] = "autoclass"
+            elif isinstance(node, ast.FunctionDef) and out.get(node.name) != "autoclass":
+                out[node.name] = "autofunction"
+        for node in ast.walk(tree):
             if isinstance(node, ast.ClassDef):
-                out.add(node.name)
-            elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) and getattr(
-                    node.value.func, "id", "") == "TypedDict":
-                out.update(t.id for t in node.targets if isinstance(t, ast.Name))
+                out[node.name] = "autoclass"
     return out
 
 
 def python_page() -> str:
-    classes = class_names()
+    kind = kinds()
     out = [header("afmdyn.__all__ (crates/afmdyn-py/python/afmdyn) by Sphinx autodoc"),
            "# Python API", "",
-           "Every public name of the `afmdyn` package (`afmdyn.__all__`) with its docstring: the "
-           "analyses' keywords, their types and defaults (from the request schemas, as the "
-           "command line's flags) and what each returns.", ""]
-    for stem, title, words in PY_GROUPS:
-        names = module_all(stem)
+           "Every public name of the `afmdyn` package (`afmdyn.__all__`) and of `afmdyn.dask` "
+           "with its docstring: the analyses' keywords, their types and defaults (from the "
+           "request schemas, as the command line's flags) and what each returns, with the "
+           "variables of its dataset (from the library's layouts).", ""]
+    for stem, follow, title, words in PY_GROUPS:
+        module = "afmdyn" if stem.startswith("_") else f"afmdyn.{stem}"
         out += [f"## {title}", "", words, "", "```{eval-rst}"]
-        for n in names:
-            if n in classes:
-                out += [f".. autoclass:: afmdyn.{n}", "   :members:", ""]
-            else:
-                out += [f".. autofunction:: afmdyn.{n}", ""]
+        for n in module_all(stem, follow):
+            directive = kind.get(n, "autofunction")
+            out += [f".. {directive}:: {module}.{n}"]
+            out += ["   :members:", ""] if directive == "autoclass" else [""]
         out[-1:] = ["```", ""]
     return "\n".join(out).rstrip("\n") + "\n"
 
