@@ -327,10 +327,27 @@ def probe_keys_page() -> str:
 # --- messages.md ---------------------------------------------------------------------------
 
 
-def sim_errors() -> List[Tuple[str, str, str]]:
-    """(variant, message template, doc comment) of each ``SimError`` variant."""
+#: the error enums of ``crates/afmdyn/src/error.rs`` the page lists: the door's, then the two
+#: whose messages it passes on (``#[error(transparent)]``)
+ENUMS = ["SimError", "ParamError", "UnitsError"]
+
+
+def enum_doc(enum: str) -> str:
+    """The doc comment of ``pub enum <enum>``."""
+    head = ERRORS.read_text().split(f"pub enum {enum} {{", 1)[0]
+    lines = []
+    for ln in reversed(head.splitlines()):
+        if ln.startswith("///"):
+            lines.insert(0, ln[3:].strip())
+        elif not ln.startswith("#["):
+            break
+    return " ".join(lines)
+
+
+def sim_errors(enum: str = "SimError") -> List[Tuple[str, str, str]]:
+    """(variant, message template, doc comment) of each variant of the error enum ``enum``."""
     src = ERRORS.read_text()
-    body = src.split("pub enum SimError {", 1)[1]
+    body = src.split(f"pub enum {enum} {{", 1)[1]
     # the enum ends at the first line that is a lone closing brace
     body = body.split("\n}\n", 1)[0]
     out = []
@@ -365,12 +382,13 @@ def message(attr: str) -> str:
     ``{name}`` kept and ``{}`` (a computed argument) written ``…``; transparent: the inner
     error's."""
     if "transparent" in attr:
-        return "(the message of the inner error)"
+        return "(the message of the error it wraps)"
     m = re.search(r'"((?:[^"\\]|\\.)*)"', attr.replace('" "', ""))
     if not m:
         return ""
     text = re.sub(r"\\\s+", "", m.group(1)).replace('\\"', '"')
-    return re.sub(r"\{\}", "…", re.sub(r"\{(\w+)(:[^}]*)?\}", r"{\1}", text))
+    text = re.sub(r"\{(\w+)(:[^}]*)?\}", r"{\1}", text).replace("{0}", "{value}")
+    return text.replace("{}", "…")
 
 
 def doc_text(doc: str) -> str:
@@ -379,15 +397,19 @@ def doc_text(doc: str) -> str:
 
 
 def messages_page() -> str:
-    out = [header("the doc comments and messages of SimError, crates/afmdyn/src/error.rs"),
+    out = [header("the doc comments and messages of SimError, ParamError and UnitsError, "
+                  "crates/afmdyn/src/error.rs"),
            "# Errors", "",
-           "Every error the library's door can give, as `SimError` declares it: the variant, its "
-           "message (`{name}` stands for a value the message names) and what it means. The "
-           "command line prints the message after `afmdyn: ` and exits 2 for bad input, 1 for a "
-           "failed run; Python raises `ValueError` (bad input) or `afmdyn.SimulationError`.", "",
-           "| Error | Message | What it means |", "|---|---|---|"]
-    for name, msg, doc in sim_errors():
-        out.append(f"| `{name}` | {cell(msg)} | {cell(doc_text(doc))} |")
+           "Every error the library's door can give, as the library declares it: the variant, its "
+           "message (`{name}` stands for a value the message names, `…` for one it computes) "
+           "and what it means. The command line prints the message after `afmdyn: ` and exits 2 "
+           "for bad input, 1 for a failed run; Python raises `ValueError` for bad input and "
+           "`afmdyn.SimulationError` for a failed run."]
+    for enum in ENUMS:
+        out += ["", f"## {enum}", "", doc_text(enum_doc(enum)), "",
+                "| Error | Message | What it means |", "|---|---|---|"]
+        for name, msg, doc in sim_errors(enum):
+            out.append(f"| `{name}` | {cell(msg)} | {cell(doc_text(doc))} |")
     return "\n".join(out) + "\n"
 
 
