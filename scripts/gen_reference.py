@@ -300,13 +300,13 @@ def probe_keys_page() -> str:
     out = [header("docs/schema/probe-keys.json (written by crates/afmdyn/tests/schema.rs from "
                   "the probe reader, the library's range table and its law registry)"),
            "# Probe keys", "",
-           "Every key of a probe file (SI units), as the library reads it: its unit and the sign "
-           "the reader checks, the physical range outside which a value is refused (a unit slip "
+           "Every key of a probe file (SI units), as the library reads it: its unit and what the "
+           "reader checks (a number's sign or range, the names a name may take), the physical range outside which a value is refused (a unit slip "
            "rather than a measurement) and the typical range outside which it is accepted with a "
            "warning; for a `[sample]` key, the contact laws that take it and the dimensionless "
            "groups of those laws it sets. A key without a unit holds a name or a list. The "
            "`[feedback]` key is the image's sample file's (`afmdyn image --sample`).", "",
-           "| Key | Unit | Must be | Refused below | Refused above | Typical | Laws | Sets |",
+           "| Key | Unit | The reader checks | Refused below | Refused above | Typical | Laws | Sets |",
            "|---|---|---|---|---|---|---|---|"]
     for k in data["keys"]:
         typical = (f"{number(k['typical'][0])} – {number(k['typical'][1])} "

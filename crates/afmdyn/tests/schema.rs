@@ -225,6 +225,21 @@ fn probe_keys() -> Value {
                 rest.split("; ").next().unwrap().to_string(),
             )
         });
+        // a name (not a number): what the reader expects instead of `zzz`
+        let named = || {
+            // (the context's own line of the key replaced: `law = "dmt"` in `[sample]`)
+            let own = format!("{key} = ");
+            let head: String = head
+                .lines()
+                .filter(|l| !l.starts_with(&own))
+                .map(|l| format!("{l}\n"))
+                .collect();
+            let text = problems(&format!("{head}{key} = \"zzz\"\n"));
+            let rest = text.split(&format!("{at} ")).nth(1)?.split_once("zzz")?.1;
+            let words = rest.split_once(": ")?.1.split("; ").next()?;
+            Some(words.to_string())
+        };
+        let must_be = checked.as_ref().map(|c| c.1.clone()).or_else(named);
         let laws: Vec<&str> = afmdyn::contact::LAWS
             .iter()
             .filter(|l| section == "sample" && l.sample_keys.contains(&key.as_str()))
@@ -242,7 +257,7 @@ fn probe_keys() -> Value {
         let entry = json!({
             "key": name,
             "unit": range.map(|r| r.unit.to_string()).or(checked.as_ref().map(|c| c.0.clone())),
-            "must_be": checked.map(|c| c.1),
+            "must_be": must_be,
             "below": range.and_then(|r| r.below.map(|b| b.0)),
             "above": range.and_then(|r| r.above.map(|b| b.0)),
             "magnitude": range.is_some_and(|r| r.magnitude),
@@ -262,9 +277,10 @@ fn probe_keys() -> Value {
                     }
                     e[f] = Value::Array(all);
                 }
-                if e["unit"].is_null() {
-                    e["unit"] = entry["unit"].clone();
-                    e["must_be"] = entry["must_be"].clone();
+                for f in ["unit", "must_be"] {
+                    if e[f].is_null() {
+                        e[f] = entry[f].clone();
+                    }
                 }
             }
             None => out.push(entry),
