@@ -10,7 +10,8 @@ and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the 
 a store; one per analysis' name); and, through ``scripts/gen_wrappers.py``, the modules
 ``afmdyn/_wrappers.py`` and ``afmdyn/_dask_wrappers.py`` of the analyses' public functions;
 and, through ``scripts/gen_cli.py``, the command line's request flags
-(``crates/afmdyn-cli/src/flags.rs`` and ``flags_afm.rs``).
+(``crates/afmdyn-cli/src/flags.rs`` and ``flags_afm.rs``); and, through
+``scripts/gen_reference.py``, the book's reference pages (``docs/reference``).
 
     python3 scripts/gen_stubs.py          # rewrite the generated block
     python3 scripts/gen_stubs.py --check  # exit 1 when it is stale (the Python tests run this)
@@ -26,6 +27,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import gen_wrappers  # noqa: E402  (the analyses' public functions, afmdyn/_wrappers.py)
 import gen_cli  # noqa: E402  (the command line's request flags, crates/afmdyn-cli/src/flags*.rs)
+import gen_reference  # noqa: E402  (the book's reference pages, docs/reference)
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = ROOT / "docs" / "schema" / "requests"
@@ -206,13 +208,18 @@ def main() -> int:
     new.update(gen_cli.generate_files())
     for path in LAW_LISTS[1:]:
         new[path] = with_laws(path.read_text())
+    new.update(gen_reference.generate())
     if "--check" in sys.argv[1:]:
         stale = [p for p, t in new.items() if not p.exists() or t != p.read_text()]
+        stale += gen_reference.stray(new)
         for p in stale:
             print(f"{p.relative_to(ROOT)} is stale: run python3 scripts/gen_stubs.py",
                   file=sys.stderr)
         return 1 if stale else 0
+    for path in gen_reference.stray(new):
+        path.unlink()
     for path, t in new.items():
+        path.parent.mkdir(exist_ok=True)
         path.write_text(t)
     return 0
 

@@ -157,7 +157,13 @@ def _clean(text: str) -> str:
     """A request's doc comment as reStructuredText: rustdoc links become literals."""
     text = re.sub(r"\[`(?:crate::)?([^`\]]+)`\]", r"``\1``", text)
     text = re.sub(r"(?<!`)`([^`]+)`(?!`)", r"``\1``", text)
-    return " ".join(text.split())
+    return _bars(" ".join(text.split()))
+
+
+def _bars(text: str) -> str:
+    """``text`` with each absolute value ``|x|`` a literal: reStructuredText reads ``|x|`` as
+    a substitution (Sphinx's autodoc of the docstrings, docs/reference/python.md)."""
+    return re.sub(r"(?<![`\w|])\|([^|\s`][^|`]*?)\|(?![`\w|])", r"``|\1|``", text)
 
 
 def _literal(value: object) -> str:
@@ -241,7 +247,7 @@ def _entries(rows: List[Tuple[str, str, str, str]]) -> List[str]:
     """One entry per variable: ``- ``name`` (dims) [units]: meaning``, wrapped."""
     out = []
     for var, over, unit, meaning in rows:
-        out += textwrap.wrap(f"- {var} ({over}) [{unit}]: {meaning}", 88,
+        out += textwrap.wrap(f"- {var} ({over}) [{unit}]: {_bars(meaning)}", 88,
                              subsequent_indent="  ", break_on_hyphens=False)
     return out
 

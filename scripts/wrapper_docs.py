@@ -268,7 +268,7 @@ Raises:
 Returns:
     ``xarray.Dataset`` over ``(y, x, attractor)``: per cell, and per attractor slot (most
     random starts first; ``max_attractors`` slots, empty ones with period 0 and NaN); a
-    ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where |λ₁| ≤ 2 × its
+    ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where ``|λ₁|`` ≤ 2 × its
     error, unsettled where λ₁ < −2 × its error. The same values as ``chart.nc``.""",
 }
 
@@ -480,7 +480,7 @@ Returns:
     "warns": """\
 Warns:
     AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,
-        k 0.01–1e6 N/m: a likely unit slip, named); data that end while |Δf| is still
+        k 0.01–1e6 N/m: a likely unit slip, named); data that end while ``|Δf|`` is still
         above 1 % of its extreme.""",
     "raises": """\
 Raises:

@@ -148,3 +148,185 @@ fn request_schemas_refuse_unknown_keys_and_flatten_groups() {
         assert!(bif["properties"].get(key).is_some(), "bifurcation: {key}");
     }
 }
+
+/// The sections of a probe file (tables at its root, not keys).
+const PROBE_SECTIONS: [&str; 5] = ["cantilever", "tip", "sample", "drive", "medium"];
+
+/// The keys of a probe file (`docs/schema/probe-keys.json`, read by `scripts/gen_reference.py`
+/// for docs/reference/probe-keys.md): every key the reader knows, by its section, with its unit
+/// and sign as the reader checks it, its physical and typical range (`probe::ranges::SI_RANGES`)
+/// and the laws whose `[sample]` takes it and the groups it sets (the registry `contact::LAWS`).
+/// The keys and their units are the reader's own: those a file with an unknown key is told to
+/// use instead, and those a key set to NaN is refused with.
+fn probe_keys() -> Value {
+    use afmdyn::probe::{ranges::SI_RANGES, Probe};
+    use serde_json::json;
+    let problems = |text: &str| -> String {
+        Probe::parse(text, "p.toml")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    // the contexts whose keys the reader lists: (section, what the file holds before them)
+    let contexts = [
+        ("", ""),
+        ("tip", "[tip]\n"),
+        ("cantilever", "model = \"beam\"\n[cantilever]\n"),
+        ("cantilever", "model = \"eigenmodes\"\n[cantilever]\n"),
+        ("drive", "[drive]\n"),
+        ("drive", "[drive]\nmode = \"off-resonance\"\n"),
+        ("medium", "[medium]\n"),
+    ];
+    let mut keys: Vec<(String, String, String)> = Vec::new(); // (section, key, header)
+    for (section, head) in contexts {
+        let text = problems(&format!("{head}zzz = 1\n"));
+        let list = text
+            .split("(expected one of: ")
+            .nth(1)
+            .unwrap()
+            .split(')')
+            .next()
+            .unwrap();
+        // (the root's sections are tables, listed under their own names)
+        for k in list
+            .split(", ")
+            .filter(|k| !section.is_empty() || !PROBE_SECTIONS.contains(k))
+        {
+            keys.push((section.into(), k.into(), head.into()));
+        }
+    }
+    for law in afmdyn::contact::LAWS {
+        for k in law.sample_keys {
+            keys.push((
+                "sample".into(),
+                (*k).into(),
+                format!("[sample]\nlaw = \"{}\"\n", law.name),
+            ));
+        }
+    }
+    let mut out: Vec<Value> = Vec::new();
+    for (section, key, head) in &keys {
+        let name = if section.is_empty() {
+            key.clone()
+        } else {
+            format!("{section}.{key}")
+        };
+        let at = if section.is_empty() {
+            key.clone()
+        } else {
+            format!("[{section}].{key}")
+        };
+        let text = problems(&format!("{head}{key} = nan\n"));
+        // `[section].key = NaN (unit): must be range`
+        let checked = text.split(&format!("{at} = NaN (")).nth(1).map(|rest| {
+            let (unit, rest) = rest.split_once("): must be ").unwrap();
+            (
+                unit.to_string(),
+                rest.split("; ").next().unwrap().to_string(),
+            )
+        });
+        // a name (not a number): what the reader expects instead of `zzz`
+        let named = || {
+            // (the context's own line of the key replaced: `law = "dmt"` in `[sample]`)
+            let own = format!("{key} = ");
+            let head: String = head
+                .lines()
+                .filter(|l| !l.starts_with(&own))
+                .map(|l| format!("{l}\n"))
+                .collect();
+            let text = problems(&format!("{head}{key} = \"zzz\"\n"));
+            let rest = text.split(&format!("{at} ")).nth(1)?.split_once("zzz")?.1;
+            let words = rest.split_once(": ")?.1.split("; ").next()?;
+            Some(words.to_string())
+        };
+        let must_be = checked.as_ref().map(|c| c.1.clone()).or_else(named);
+        let laws: Vec<&str> = afmdyn::contact::LAWS
+            .iter()
+            .filter(|l| section == "sample" && l.sample_keys.contains(&key.as_str()))
+            .map(|l| l.name)
+            .collect();
+        let groups: Vec<String> = afmdyn::contact::LAWS
+            .iter()
+            .flat_map(|l| l.params.iter().map(move |p| (l, p)))
+            .filter(|(_, p)| section == "sample" && p.si_keys.contains(&key.as_str()))
+            .map(|(l, p)| format!("{} ({})", p.name, l.name))
+            .collect();
+        let range = SI_RANGES
+            .iter()
+            .find(|r| r.sections.contains(&section.as_str()) && r.keys.contains(&key.as_str()));
+        let entry = json!({
+            "key": name,
+            "unit": range.map(|r| r.unit.to_string()).or(checked.as_ref().map(|c| c.0.clone())),
+            "must_be": must_be,
+            "below": range.and_then(|r| r.below.map(|b| b.0)),
+            "above": range.and_then(|r| r.above.map(|b| b.0)),
+            "magnitude": range.is_some_and(|r| r.magnitude),
+            "typical": range.and_then(|r| r.typical.map(|t| json!([t.0, t.1, t.2]))),
+            "laws": laws,
+            "groups": groups,
+        });
+        match out.iter_mut().find(|e| e["key"] == entry["key"]) {
+            // a key of several contexts (a law's [sample]): the laws and groups of all
+            Some(e) => {
+                for f in ["laws", "groups"] {
+                    let mut all = e[f].as_array().unwrap().clone();
+                    for v in entry[f].as_array().unwrap() {
+                        if !all.contains(v) {
+                            all.push(v.clone());
+                        }
+                    }
+                    e[f] = Value::Array(all);
+                }
+                for f in ["unit", "must_be"] {
+                    if e[f].is_null() {
+                        e[f] = entry[f].clone();
+                    }
+                }
+            }
+            None => out.push(entry),
+        }
+    }
+    // the ranged keys of other files (the image's [feedback])
+    for r in SI_RANGES {
+        for s in r.sections {
+            for k in r.keys {
+                let name = format!("{s}.{k}");
+                let read = |e: &Value| e["key"].as_str().unwrap().starts_with(&format!("{s}."));
+                if !out.iter().any(read) {
+                    out.push(json!({"key": name, "unit": r.unit, "must_be": null,
+                        "below": r.below.map(|b| b.0), "above": r.above.map(|b| b.0),
+                        "magnitude": r.magnitude, "typical": r.typical.map(|t| json!([t.0, t.1, t.2])),
+                        "laws": [], "groups": []}));
+                }
+            }
+        }
+    }
+    let laws: serde_json::Map<String, Value> = afmdyn::contact::LAWS
+        .iter()
+        .map(|l| (l.name.to_string(), json!(l.sample_keys)))
+        .collect();
+    json!({
+        "description": "Every key of a probe file, written by crates/afmdyn/tests/schema.rs from \
+            the probe reader (its keys and the unit and sign it checks), its range table \
+            (probe::ranges::SI_RANGES: refused outside [below, above], warned outside the \
+            typical range) and the law registry (contact::LAWS: the laws whose [sample] takes a \
+            key, the groups it sets).",
+        "keys": out,
+        "laws": laws,
+    })
+}
+
+#[test]
+fn probe_keys_match_the_committed_file() {
+    let path = dir().join("../probe-keys.json");
+    let text = serde_json::to_string_pretty(&probe_keys()).unwrap() + "\n";
+    if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
+        std::fs::write(&path, &text).unwrap();
+    }
+    assert_eq!(
+        std::fs::read_to_string(&path).ok().as_deref(),
+        Some(text.as_str()),
+        "docs/schema/probe-keys.json differs from the library; regenerate with \
+         AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::schema::"
+    );
+}

@@ -32,7 +32,7 @@ class RegionSpectrum:
         omega: undamped natural frequencies ω_i, ascending, float64 ``[N]`` (units 1/t0).
         eigenvalues: damped eigenvalues λ of eqs. 20–21 with Im λ ≥ 0, sorted by Im,
             complex128 ``[k]`` (k = N when every mode is underdamped).
-        zeta: damping ratios ζ = −Re λ/|λ|, float64 ``[k]``.
+        zeta: damping ratios ζ = −Re λ/``|λ|``, float64 ``[k]``.
     """
 
     omega: np.ndarray
@@ -70,7 +70,7 @@ class Orbit(_Document):
             ``[2N]``.
         stable: all multipliers inside the unit circle; critical: how the largest one would
             cross it (``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``).
-        grazing, grazing_distance: near-grazing flag and distance (g0, and |dV_T/dτ|/Ω).
+        grazing, grazing_distance: near-grazing flag and distance (g0, and ``|dV_T/dτ|``/Ω).
         switchings: switchings per cycle; newton_residuals: ‖Pⁿ(z) − z‖ per iteration.
     """
 

@@ -387,7 +387,7 @@ def continuation(
         - ``s`` (point) [1]: arclength
         - ``value`` (point) [1]: Ω (omega)
         - ``stable`` (point) [1]: stable (every Floquet multiplier inside the unit circle)
-        - ``max_multiplier`` (point) [1]: largest |Floquet multiplier|
+        - ``max_multiplier`` (point) [1]: largest ``|Floquet multiplier|``
         - ``critical`` (point) [1]: how the orbit is or would become unstable
         - ``switchings`` (point) [1]: switchings per cycle
         - ``grazing_distance`` (point) [g0]: distance to grazing
@@ -562,7 +562,7 @@ def chart(
     Returns:
         ``xarray.Dataset`` over ``(y, x, attractor)``: per cell, and per attractor slot (most
         random starts first; ``max_attractors`` slots, empty ones with period 0 and NaN); a
-        ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where |λ₁| ≤ 2 × its
+        ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where ``|λ₁|`` ≤ 2 × its
         error, unsettled where λ₁ < −2 × its error. The same values as ``chart.nc``.
 
         Its variables (name (dims) [units]: meaning), as the library lays them out

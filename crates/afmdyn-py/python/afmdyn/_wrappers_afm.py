@@ -600,8 +600,8 @@ def fm(
         step: Step of z_c; excludes ``points``.
         to: Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0
             for the laws without attraction).
-        tolerance: Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in
-            (0, 1e-3).
+        tolerance: Tolerance of the loop conditions, ``|A₁/A − 1|`` and ``|φ₁ − φ_set|``
+            (rad), in (0, 1e-3).
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
@@ -636,7 +636,7 @@ def fm(
         - ``max_multiplier`` (z_c) [1]: largest Floquet multiplier modulus under the locked
           drive
         - ``stable`` (z_c) [—]: Floquet-stable under the locked drive
-        - ``loop_residual`` (z_c) [1]: loop residual max(|A1/A − 1|, |φ1 − φ_set|)
+        - ``loop_residual`` (z_c) [1]: loop residual max(``|A1/A − 1|``, ``|φ1 − φ_set|``)
         - ``iterations`` (z_c) [1]: Newton iterations on (Ω, α2)
 
     Raises:
@@ -1124,7 +1124,7 @@ def reconstruct(
 
     Warns:
         AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,
-            k 0.01–1e6 N/m: a likely unit slip, named); data that end while |Δf| is still
+            k 0.01–1e6 N/m: a likely unit slip, named); data that end while ``|Δf|`` is still
             above 1 % of its extreme.
 
     Raises:
