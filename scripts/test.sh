@@ -8,16 +8,20 @@
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it, reusing the
 #      library the Rust tests compiled: scripts/check-feature-unification.sh), then
-#      pytest crates/afmdyn-py/tests, which also executes the example notebook and script; then
-#      tests/test_toy_law.py against a second wheel built with the toy law (feature toy-law).
+#      pytest crates/afmdyn-py/tests, which also executes the example notebook and script and
+#      runs every page of the book (tests/test_docs.py); then tests/test_toy_law.py against a
+#      second wheel built with the toy law (feature toy-law). Before pytest, the book:
+#      docs/requirements.txt into the venv and bash scripts/build-book.sh into $TARGET/book
+#      (Sphinx -W: one test, failed by any warning).
 #   3. the WebAssembly engine: bash scripts/test-wasm.sh (crates/afmdyn-wasm built for wasm32,
 #      its JavaScript glue by wasm-bindgen-cli, checked under Node.js against the command line).
 #   4. the explorer in a real browser: bash scripts/test-explorer.sh (the static page built with
 #      its npm packages, served on 127.0.0.1, driven in Debian's headless Chromium, installed with
-#      apt-get when missing, by playwright-core, against the command line).
+#      apt-get when missing, by playwright-core, against the command line), and the book's pages
+#      opened in the same browser (explorer/tests/book.mjs).
 # Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
-# The last line is "N passed, N failed", Rust, Python and wasm together; the exit status is 0 only
-# when everything ran and passed.
+# The last line is "N passed, N failed", Rust, Python, the book, wasm and the explorer together;
+# the exit status is 0 only when everything ran and passed.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -49,6 +53,8 @@ fi
 py="$VENV/bin/python"
 py_passed=0
 py_failed=0
+book_passed=0
+book_failed=0
 toy="$logs/toy"
 # Beside pytest, which leaves a core mostly idle, in the background: the toy contact law
 # (feature toy-law, not shipped: a law is one file plus one registry line) — its Rust test
@@ -73,6 +79,19 @@ if [ -x "$py" ]; then
     "$py" -m pip install -q --upgrade pip 2>&1 | tail -1
     echo "== Python: pip install ./crates/afmdyn-py[test] (maturin builds the extension)"
     if "$py" -m pip install -q "./crates/afmdyn-py[test]"; then
+        # the book (issue 80): its builder (docs/requirements.txt, also the docs test's Markdown
+        # parser) into the venv, then Sphinx with -W over docs/ into $TARGET/book, where the
+        # explorer's browser suite opens it; one test, failed by any warning
+        echo "== the book: pip install -r docs/requirements.txt; bash scripts/build-book.sh $TARGET/book"
+        if "$py" -m pip install -q -r docs/requirements.txt &&
+            PYTHON_BOOK="$py" bash scripts/build-book.sh "$TARGET/book"; then
+            book_passed=1
+            echo "the book: built without warnings into $TARGET/book"
+        else
+            book_failed=1
+            status=1
+            echo "the book: the build failed or warned"
+        fi
         background > "$logs/background.log" 2>&1 &
         bg=$!
         echo "== Python: pytest crates/afmdyn-py/tests"
@@ -160,6 +179,6 @@ suite wasm scripts/test-wasm.sh
 echo "== Explorer: bash scripts/test-explorer.sh (the page in headless Chromium)"
 suite explorer scripts/test-explorer.sh
 
-echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed; explorer: ${explorer_passed:-0} passed, ${explorer_failed:-0} failed"
-echo "$((rust_passed + py_passed + ${wasm_passed:-0} + ${explorer_passed:-0})) passed, $((rust_failed + py_failed + ${wasm_failed:-0} + ${explorer_failed:-0} + extra_failed)) failed"
+echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; book: ${book_passed} passed, ${book_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed; explorer: ${explorer_passed:-0} passed, ${explorer_failed:-0} failed"
+echo "$((rust_passed + py_passed + book_passed + ${wasm_passed:-0} + ${explorer_passed:-0})) passed, $((rust_failed + py_failed + book_failed + ${wasm_failed:-0} + ${explorer_failed:-0} + extra_failed)) failed"
 exit "$status"

@@ -1,17 +1,58 @@
-"""The README's commands cannot drift: every ``cargo run --release -- …`` line of its code blocks
-is run, in the README's order, with the binary of this checkout in a scratch directory (the
-repository's ``examples/`` linked into it, so relative paths resolve and ``afmdyn-out/`` is
-written there), and must exit 0 with nothing on stderr but warnings and progress.
-(``bash scripts/…`` lines are scripts of their own and not run here.)"""
+"""The book and the README cannot drift (issue 80): every page — the README and every
+``docs/**/*.md`` — runs its ``console`` and ``python`` blocks by the conventions of
+``docs_harness.py`` (one case per page, in its own scratch directory), and its relative links and
+``#anchors`` resolve; the README's ``cargo run --release -- …`` lines run; every subcommand and
+flag the pages name exists in ``--help``; a refusal shown in a shown-only block (``sh``) is
+what the command prints. (The book's build without warnings is scripts/test.sh's, with
+scripts/build-book.sh.)"""
 
 from __future__ import annotations
 
 import re
 import shlex
-from typing import List
+from pathlib import Path
+from typing import List, Tuple
 
-from conftest import REPO
+import pytest
 
+import docs_harness as h
+from conftest import REPO, _binary
+
+DOCS = REPO / "docs"
+# docs/conf.py's exclude_patterns: the figures' and the build's folders hold no pages
+PAGES = sorted(p for p in DOCS.rglob("*.md")
+               if not {"_build", "figures"} & set(p.relative_to(DOCS).parts))
+ALL = [REPO / "README.md", *PAGES]
+IDS = [str(p.relative_to(REPO)) for p in ALL]
+
+
+# ------------------------------------------------------------------ every page's examples and links
+
+@pytest.mark.parametrize("page", ALL, ids=IDS)
+def test_the_page_runs(page: Path, cli, tmp_path, monkeypatch):
+    """The page's console and python blocks, in page order, in a scratch directory."""
+    monkeypatch.setenv("MPLBACKEND", "Agg")  # a python block's plots go nowhere
+    cwd = h.scratch_dir(tmp_path / "page", REPO)
+    timings: List[Tuple[str, float]] = []
+    failures = h.run_page(page, _binary(), cwd, str(page.relative_to(REPO)), timings)
+    slow = [f"{w}: {t:.1f} s" for w, t in timings if t > 10]
+    if slow:
+        print("slow examples (reduce them with a replace directive):", *slow, sep="\n  ")
+    assert not failures, "\n".join(failures)
+
+
+@pytest.mark.parametrize("page", ALL, ids=IDS)
+def test_the_page_links_resolve(page: Path):
+    failures = h.check_links(page, REPO, str(page.relative_to(REPO)))
+    assert not failures, "\n".join(failures)
+
+
+def test_the_book_has_its_pages():
+    names = {str(p.relative_to(DOCS)) for p in PAGES}
+    assert {"index.md", "getting-started.md", "outputs.md", "contact-laws.md"} <= names
+
+
+# ------------------------------------------------------------------------------ the README's lines
 
 def readme_commands() -> List[List[str]]:
     text = (REPO / "README.md").read_text(encoding="utf-8")
@@ -32,6 +73,9 @@ def test_readme_lists_the_commands():
 
 
 def test_every_readme_command_runs(cli, tmp_path):
+    """Every ``cargo run --release -- …`` line of the README's blocks, in order, with the
+    binary of this checkout in a scratch directory (``examples/`` linked into it), exits 0 with
+    nothing on stderr but warnings and progress."""
     (tmp_path / "examples").symlink_to(REPO / "examples")
     for args in readme_commands():
         run = cli(*args, cwd=tmp_path)
@@ -40,57 +84,57 @@ def test_every_readme_command_runs(cli, tmp_path):
             assert "error" not in line.lower() or "warning" in line, f"{' '.join(args)}: {line}"
 
 
-DOCS = sorted((REPO / "docs").glob("*.md"))
-
+# ------------------------------------------------------------- the subcommands and flags named
 
 def inline_commands() -> List[tuple]:
-    """Every ``afmdyn SUBCOMMAND …`` written in backticks in docs/*.md and the README:
-    (file, subcommand, its ``--flags``)."""
+    """Every ``afmdyn SUBCOMMAND …`` written in backticks in the pages: (page, subcommand,
+    its ``--flags``)."""
     found = []
-    for path in [REPO / "README.md", *DOCS]:
+    for path in ALL:
         text = path.read_text(encoding="utf-8")
         for m in re.finditer(r"`afmdyn ([a-z]+)((?: [^`]*)?)`", text):
             found.append((path.name, m.group(1), re.findall(r"--[a-z][a-z0-9-]*", m.group(2))))
     return found
 
 
-def block_commands(refused: bool = False) -> List[tuple]:
-    """The ``afmdyn …`` lines of docs/*.md's code blocks (``$ `` prompts stripped); with
-    ``refused``, (file, args, message) of those the docs show refused: followed in their block
-    by the line ``afmdyn: …`` the command prints."""
+def block_commands() -> List[tuple]:
+    """The ``afmdyn …`` commands of the pages' code blocks (``console``, ``sh``, ``bash``, no
+    info string; ``$ `` prompts stripped, `` \\`` continuations joined): (page, args, the
+    block's info string, the lines after the command up to the next command in its block)."""
     found = []
-    shown = []
-    for path in DOCS:
-        fence = None  # the open block's language, None outside a block
-        last = None
-        for line in path.read_text(encoding="utf-8").splitlines():
-            if line.startswith("```"):
-                fence = None if fence is not None else line[3:].strip()
-                last = None
+    for path in ALL:
+        for block in h.blocks(path.read_text(encoding="utf-8"), path.name):
+            if block.info not in ("", "sh", "bash", "shell", "console"):
                 continue
-            line = line.strip()
-            if line.startswith("afmdyn: ") and last is not None:
-                shown.append((path.name, last, line))
-                continue
-            if line.startswith("$ "):
-                line = line[2:]
-            last = None
-            if fence in ("", "sh", "bash", "console") and line.startswith("afmdyn "):
-                last = shlex.split(line[len("afmdyn "):], comments=True)
-                found.append((path.name, last))
-    if refused:
-        return shown
-    return [(n, a) for n, a in found if not any(a is s[1] for s in shown)]
+            lines = block.text.splitlines()
+            i = 0
+            while i < len(lines):
+                line = lines[i].strip()
+                if line.startswith("$ "):
+                    line = line[2:]
+                while line.endswith("\\") and i + 1 < len(lines):
+                    i += 1
+                    line = line[:-1].rstrip() + " " + lines[i].strip()
+                i += 1
+                if not line.startswith("afmdyn "):
+                    continue
+                after = []
+                while i < len(lines) and not re.match(r"\s*(\$ )?afmdyn ", lines[i]):
+                    after.append(lines[i].strip())
+                    i += 1
+                found.append((path.name, shlex.split(line[len("afmdyn "):], comments=True),
+                              block.info, after))
+    return found
 
 
 def test_every_flag_the_docs_name_exists(cli):
-    """Issue 28 item 9: a subcommand or flag written in the docs (inline or in a code block)
-    that the command line does not have is drift. Checked against ``--help``, without
-    running (the docs' commands are examples with placeholders: P, DIR, α5)."""
+    """Issue 28 item 9: a subcommand or flag written in the pages (inline or in a code block)
+    that the command line does not have is drift. Checked against ``--help``, without running
+    (shown-only commands are examples with placeholders: P, DIR, α5)."""
     top = cli("--help").stdout
     helps: dict = {}
     cases = inline_commands() + [(f, a[0], [t for t in a if t.startswith("--")])
-                                 for f, a in block_commands()]
+                                 for f, a, _, _ in block_commands() if a]
     assert len(cases) >= 30
     for name, sub, flags in cases:
         assert re.search(rf"^  {sub}\b", top, flags=re.M), f"{name}: no subcommand {sub}"
@@ -102,38 +146,166 @@ def test_every_flag_the_docs_name_exists(cli):
                 f"{name}: afmdyn {sub} has no {flag}"
 
 
-def test_the_docs_code_block_commands_run(cli, tmp_path):
-    """The docs' code-block commands run as written, in short variants: approach, bimodal and
-    resonance with 6 points, no branches and no files (the grid and the model are the
-    docs'); redirections dropped; a command the docs show failing (``bad.toml``) skipped."""
+def test_the_refusals_shown_are_what_the_command_prints(cli, tmp_path):
+    """A refusal a shown-only block (``sh``, ``bash``) shows — a command followed by the line
+    ``afmdyn: …`` it prints — is the command's: exit status 2 and that stderr. (A console
+    block's are run by test_the_page_runs; ``bad.toml``'s is abridged in the text.)"""
     (tmp_path / "examples").symlink_to(REPO / "examples")
-    ran = 0
-    for name, args in block_commands():
-        if any("bad" in a for a in args):
-            continue
-        if ">" in args:
-            args = args[: args.index(">")]
-        if args[0] in ("approach", "resonance", "bimodal"):
-            drop = {"--points", "--step"}
-            short = []
-            skip = False
-            for a in args:
-                if skip:
-                    skip = False
-                    continue
-                if a in drop:
-                    skip = True
-                    continue
-                short.append(a)
-            args = short + ["--points", "6", "--no-branches", "--files", "none"]
-        run = cli(*args, cwd=tmp_path)
-        assert run.returncode == 0, f"{name}: afmdyn {' '.join(args)}: {run.stderr}"
-        ran += 1
-    assert ran >= 4
-    # the refusals the docs show are what the command prints (bad.toml's is abridged there)
-    for name, args, message in block_commands(refused=True):
-        if any("bad" in a for a in args):
+    for name, args, info, after in block_commands():
+        shown = [a for a in after if a.startswith("afmdyn: ")]
+        if info == "console" or not shown or any("bad" in a for a in args):
             continue
         run = cli(*args, cwd=tmp_path)
         assert run.returncode == 2, f"{name}: afmdyn {' '.join(args)}: {run.stderr}"
-        assert run.stderr.strip() == message, f"{name}: {run.stderr!r} vs {message!r}"
+        assert run.stderr.strip() == shown[0], f"{name}: {run.stderr!r} vs {shown[0]!r}"
+
+
+# ------------------------------------------------------------------ the harness on a fixture page
+
+FIXTURE = '''# A page
+
+## The `--out` flag: files, *and* Ω α₅ — naïve $x$ here
+
+## A page
+
+Links: [ok](#a-page-1), [flag](#the---out-flag-files-and-ω-α₅--naïve--here),
+[broken anchor](#nowhere), [missing](missing.md), [repo file](../../crates/afmdyn-py/tests/conftest.py),
+[web](https://example.org/x.md), `[in code](nothere.md)`.
+
+```console
+$ afmdyn modes
+free (region I)
+   i   ω (undamped) ... Q
+$ afmdyn simulate \\
+    --periods -1
+afmdyn: periods = -1: must be ...
+```
+
+<!-- docs-test: file probe-copy.toml -->
+```toml
+# written to the scratch directory
+```
+
+<!-- docs-test: replace "--periods 1e9" "--periods 2" -->
+```console
+$ afmdyn simulate --periods 1e9 --files none
+this line is not compared under a replace directive
+```
+
+<!-- docs-test: skip: shown only, it would take hours -->
+```console
+$ afmdyn nonsense
+```
+
+```python
+import pathlib
+n = len(pathlib.Path("probe-copy.toml").read_text())
+```
+
+```python
+assert n > 0 and pathlib.Path("examples").is_dir() and pathlib.Path("docs").is_dir()
+```
+
+```sh
+$ afmdyn not run: shown only
+```
+'''
+
+
+def fixture(tmp_path: Path, text: str = FIXTURE) -> Path:
+    page = tmp_path / "docs" / "sub" / "page.md"
+    page.parent.mkdir(parents=True)
+    page.write_text(text, encoding="utf-8")
+    return page
+
+
+def test_harness_parses_blocks_and_directives(tmp_path):
+    found = h.blocks(FIXTURE)
+    assert [b.info for b in found] == ["console", "toml", "console", "console", "python",
+                                       "python", "sh"]
+    assert found[1].file == "probe-copy.toml"
+    assert found[2].replace == [("--periods 1e9", "--periods 2")]
+    assert found[3].skip == "shown only, it would take hours"
+    commands = h.console_commands(found[0])
+    assert [c.text for c in commands] == ["afmdyn modes", "afmdyn simulate --periods -1"]
+    assert [c.refusal for c in commands] == [False, True]
+    assert commands[0].quoted == ["free (region I)", "   i   ω (undamped) ... Q"]
+    with pytest.raises(h.DocsError, match="needs a reason"):
+        h.blocks("<!-- docs-test: skip -->\n```console\n$ afmdyn modes\n```\n")
+    with pytest.raises(h.DocsError, match="pairs"):
+        h.blocks('<!-- docs-test: replace "a" -->\n```console\n$ afmdyn modes\n```\n')
+    with pytest.raises(h.DocsError, match="not right before"):
+        h.blocks("<!-- docs-test: skip: x -->\n\n```console\n$ afmdyn modes\n```\n")
+    with pytest.raises(h.DocsError, match="unknown"):
+        h.blocks("<!-- docs-test: run -->\n```console\n$ afmdyn modes\n```\n")
+
+
+def test_harness_quoted_output():
+    out = "free (region I)\n   i   ω (undamped)           Re λ     Q\n"
+    assert h.quoted_line_matches("i ω (undamped) ... Q", out)
+    assert h.quoted_line_matches("free (region I)", out)
+    assert not h.quoted_line_matches("free (region II)", out)
+    # `...` stays within one line of the output
+    assert not h.quoted_line_matches("free ... Re λ", out)
+
+
+def test_harness_runs_the_fixture_page(tmp_path, cli):
+    page = fixture(tmp_path)
+    cwd = h.scratch_dir(tmp_path / "scratch", REPO)
+    assert h.run_page(page, _binary(), cwd) == []
+    assert (cwd / "probe-copy.toml").exists()
+
+
+def test_harness_reports_what_drifted(tmp_path, cli):
+    page = fixture(tmp_path, FIXTURE
+                   .replace("free (region I)", "free (region IX)")
+                   .replace("must be ...", "must be positive")
+                   .replace('"--periods 2"', '"--periods 0"')
+                   .replace("n > 0", "n < 0")
+                   .replace("$ afmdyn simulate \\", "$ afmdyn simulate > out.txt \\"))
+    cwd = h.scratch_dir(tmp_path / "scratch", REPO)
+    failures = h.run_page(page, _binary(), cwd, "page.md")
+    text = "\n".join(failures)
+    assert "page.md:12: afmdyn modes: quoted output not in the output: ['free (region IX)']" in text
+    assert "shell syntax ['>']" in text
+    assert "exit status 2, the page shows a success (0)" in text  # --periods 0, replaced
+    assert "page.md:41: the python block raised AssertionError" in text
+    assert len(failures) == 4, text
+    # a refusal's quoted line is compared too
+    page.write_text("```console\n$ afmdyn simulate --periods -1\nafmdyn: periods = -1: "
+                    "must be positive\n```\n", encoding="utf-8")
+    assert "quoted output not in the output" in "\n".join(h.run_page(page, _binary(), cwd))
+    # a replace whose OLD the block no longer has
+    page.write_text('<!-- docs-test: replace "--steps 400" "--steps 4" -->\n'
+                    "```console\n$ afmdyn modes\n```\n", encoding="utf-8")
+    assert "does not occur" in "\n".join(h.run_page(page, _binary(), cwd))
+    # only afmdyn commands
+    page.write_text("```console\n$ rm -rf docs\n```\n", encoding="utf-8")
+    assert "only 'afmdyn ...' commands" in "\n".join(h.run_page(page, _binary(), cwd))
+
+
+def test_harness_checks_links_and_anchors(tmp_path):
+    page = fixture(tmp_path)
+    # the fixture's repository: tmp_path, with crates/afmdyn-py/tests/conftest.py in it
+    (tmp_path / "crates" / "afmdyn-py" / "tests").mkdir(parents=True)
+    (tmp_path / "crates" / "afmdyn-py" / "tests" / "conftest.py").write_text("")
+    failures = h.check_links(page, tmp_path, "page.md")
+    assert failures == ["page.md: link '#nowhere': no heading #nowhere in page.md",
+                        "page.md: link 'missing.md': no file missing.md"], failures
+    other = page.parent / "other.md"
+    other.write_text("[a](page.md#the---out-flag-files-and-ω-α₅--naïve--here) "
+                     "[b](page.md#a-page-2) [c](../../crates/none.rs)\n", encoding="utf-8")
+    assert h.check_links(other, tmp_path, "other.md") == [
+        "other.md: link 'page.md#a-page-2': no heading #a-page-2 in page.md",
+        "other.md: link '../../crates/none.rs': no file ../../crates/none.rs"]
+
+
+def test_harness_slugs_are_myst_s():
+    """The slugs of the headings above as MyST 5.2 writes them in the HTML (checked by
+    building a page with them: ids the-out-flag… are docutils' own, not linkable by slug)."""
+    text = ("# Top\n\n## The `--out` flag: files, and *emphasis* & [a link](x.md)\n\n"
+            "## Unicode: Ω and α₅ — μm, naïve\n\n## Math $\\omega$ here\n\n## Top\n\n## Top\n\n"
+            "##### Level five\n")
+    assert h.heading_slugs(text) == {
+        "top", "the---out-flag-files-and-emphasis--a-link", "unicode-ω-and-α₅--μm-naïve",
+        "math--here", "top-1", "top-2"}
