@@ -7,7 +7,7 @@ E = 4 GPa and H = 6.6e-20 J, z_offset = 1 nm). For each parameter: the fraction 
 95 % interval (the document's `interval`: Wald, ±1.96 standard errors, unless EXTRA asks for
 profiles) covers the truth (goal 90–99 %), the mean reported standard error beside the standard
 deviation of the estimates over the draws (equal when the Wald intervals are honest), and the
-mean χ²/dof. Writes the "fit-coverage" section of docs/performance.md (scripts/doc_section.py)
+mean χ²/dof. Writes the "fit-coverage" section of docs/performance/commands.md (scripts/doc_section.py)
 when DRAWS is the default 100 and no PROBE is given.
 
 Usage: python3 scripts/fit-coverage.py [DRAWS] [PROBE] [EXTRA FIT ARGUMENTS…]   (AFMDYN_BIN: the

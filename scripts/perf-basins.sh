@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Basin maps" section of docs/performance.md (issue 30): a basin map (early
+# Regenerate the "Basin maps" section of docs/performance/commands.md (issue 30): a basin map (early
 # stopping: near a known periodic attractor, recurrence in labelled state-space cells, and on
 # N = 1 the coarse grids of earlier passes) against running every start to its steady state one
 # by one (the census's way), one thread, with the share of identical labels: the impact
@@ -35,4 +35,4 @@ PY
   echo "<!-- basins:end -->"
 } > "$section"
 python3 scripts/doc_section.py basins "$section" "Basin maps"
-sed -n '/basins:begin/,/basins:end/p' docs/performance.md
+sed -n '/basins:begin/,/basins:end/p' "$(python3 scripts/doc_section.py --where basins)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Bimodal AM curves" section of docs/performance.md (issue 44): `afmdyn bimodal`
+# Regenerate the "Bimodal AM curves" section of docs/performance/commands.md (issue 44): `afmdyn bimodal`
 # over 100 z_c values (the default range) on examples/probe-bimodal.toml (the eigenmode model,
 # f2/f1 = 25/4: a common period of 4 drive periods), with and without the branches; the same
 # lever with f2/f1 = 94/15 (mode 2 at 1.88 MHz, the beam's 6.27: 15 periods); and, for the
@@ -124,4 +124,4 @@ section=$(mktemp)
     echo "<!-- bimodal:end -->"
 } > "$section"
 python3 scripts/doc_section.py bimodal "$section" "Bimodal AM curves (issue 44)"
-sed -n '/bimodal:begin/,/bimodal:end/p' docs/performance.md
+sed -n '/bimodal:begin/,/bimodal:end/p' "$(python3 scripts/doc_section.py --where bimodal)"

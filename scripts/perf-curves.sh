@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "curves" section of docs/performance.md: the default `afmdyn resonance` and
+# Regenerate the "curves" section of docs/performance/analyses.md: the default `afmdyn resonance` and
 # `afmdyn approach` with the two DMT example probes (point mass, three-mode beam), each run in
 # a scratch directory writing its default files. Wall and CPU seconds: best of 5 runs each
 # (the shared machine's load scatters single runs by tens of percent). With --instructions also
@@ -70,7 +70,7 @@ block=$(mktemp)
 } > "$block"
 if [ "$write_docs" = 1 ]; then
   python3 scripts/doc_section.py curves "$block" "Approach and resonance curves"
-  sed -n '/curves:begin/,/curves:end/p' docs/performance.md
+  sed -n '/curves:begin/,/curves:end/p' "$(python3 scripts/doc_section.py --where curves)"
 else
   cat "$block"
 fi

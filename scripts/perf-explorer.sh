@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "The explorer in Chromium" section of docs/performance.md (issue 47): the page's
+# Regenerate the "The explorer in Chromium" section of docs/performance/commands.md (issue 47): the page's
 # own timings in headless Chromium, measured by the browser test (explorer/tests/browser.mjs,
 # run by scripts/test-explorer.sh, which must pass): the default Fig. 5 diagram from the request
 # to its last point drawn, a click on the diagram to the orbit shown (and with its time series),
@@ -33,4 +33,4 @@ with open(out, "w") as f:
     f.write("<!-- explorer:end -->\n")
 PY
 python3 scripts/doc_section.py explorer "$section" "The explorer in Chromium (issue 47)"
-sed -n '/explorer:begin/,/explorer:end/p' docs/performance.md
+sed -n '/explorer:begin/,/explorer:end/p' "$(python3 scripts/doc_section.py --where explorer)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Dynamic AM fit (issue 62)" section of docs/performance.md: `afmdyn fit` of
+# Regenerate the "Dynamic AM fit (issue 62)" section of docs/performance/commands.md: `afmdyn fit` of
 # sample.youngs_modulus, sample.hamaker and z_offset to a synthetic 100-row AM approach
 # (amplitude and phase against the piezo position z, z_c = 7.5 → 3 nm, the repulsive branch below
 # the approach's fold; σ = 0.02 nm and 0.1°, seeded Gaussian noise; truth: the probe's E and H and
@@ -86,4 +86,4 @@ section=$(mktemp)
     echo "<!-- fit-dynamic:end -->"
 } > "$section"
 python3 scripts/doc_section.py fit-dynamic "$section" "Dynamic AM fit (issue 62)"
-sed -n '/fit-dynamic:begin/,/fit-dynamic:end/p' docs/performance.md
+sed -n '/fit-dynamic:begin/,/fit-dynamic:end/p' "$(python3 scripts/doc_section.py --where fit-dynamic)"

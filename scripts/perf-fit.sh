@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Force-curve fit (issue 62)" section of docs/performance.md: `afmdyn fit` on a
+# Regenerate the "Force-curve fit (issue 62)" section of docs/performance/commands.md: `afmdyn fit` on a
 # synthetic Hertz approach of 10^4 rows (E = 5 kPa, R = 5 µm, k = 0.05 N/m, 20 pN of seeded
 # Gaussian noise; examples/probe-fit-hertz.toml), fitting sample.youngs_modulus, contact_point
 # and baseline with their profiles. The whole command (reading, preprocessing, fit, profiles,
@@ -70,4 +70,4 @@ print(f"`bash scripts/perf-fit.sh` on this machine (2 cores, shared; load {load}
 print("<!-- fit:end -->")
 PY
 python3 scripts/doc_section.py fit "$section" "Force-curve fit (issue 62)"
-sed -n '/fit:begin/,/fit:end/p' docs/performance.md
+sed -n '/fit:begin/,/fit:end/p' "$(python3 scripts/doc_section.py --where fit)"

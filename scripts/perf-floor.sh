@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate two sections of docs/performance.md from callgrind profiles of the exact propagator
+# Regenerate two sections of docs/performance/recording.md from callgrind profiles of the exact propagator
 # at N = 1, 3, 10, 20 (default parameters, Ω = 2.6), each per forcing period as the difference
 # of two runs of different lengths (which excludes the build and the transient):
 # - "Distance to the floor": the instructions through `advance` split against the floor of
@@ -62,4 +62,4 @@ python3 scripts/doc_section.py floor "$table" "Distance to the floor"
   echo "<!-- record:end -->"
 } > "$table"
 python3 scripts/doc_section.py record "$table" "Recording a steady state"
-sed -n '/floor:begin/,/floor:end/p;/record:begin/,/record:end/p' docs/performance.md
+sed -n '/floor:begin/,/floor:end/p;/record:begin/,/record:end/p' "$(python3 scripts/doc_section.py --where floor)"

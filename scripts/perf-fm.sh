@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "FM-AFM curves" section of docs/performance.md (issue 44): `afmdyn fm` over
+# Regenerate the "FM-AFM curves" section of docs/performance/commands.md (issue 44): `afmdyn fm` over
 # 100 z_c values (the default range, 2A + a0 down to A + a0) on the point-mass and the beam
 # (N = 3) DMT example probes, and on the point mass at Q = 10^4; whole command (outputs and
 # plot included), best of 5. Goal: ≤ 2 s on the point mass. Then the time-domain loop against
@@ -61,4 +61,4 @@ section=$(mktemp)
     echo "<!-- fm:end -->"
 } > "$section"
 python3 scripts/doc_section.py fm "$section" "FM-AFM curves (issue 44)"
-sed -n '/fm:begin/,/fm:end/p' docs/performance.md
+sed -n '/fm:begin/,/fm:end/p' "$(python3 scripts/doc_section.py --where fm)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "A real lever at its defaults" section of docs/performance.md (issue 42,
+# Regenerate the "A real lever at its defaults" section of docs/performance/commands.md (issue 42,
 # section 1): the RTESPA-300 (Q = 500) over polystyrene, examples/probe-rtespa300-polystyrene.toml,
 # at z_c = 14.3 nm (two coexisting period-1 orbits):
 #   1. `afmdyn attractors --samples 64` at its defaults, whole command, best of 3 (goal ≤ 2 s);
@@ -60,4 +60,4 @@ print("`bash scripts/perf-high-q.sh [STRIDE]` on this machine (2 cores); the cen
 print("<!-- high-q:end -->")
 PY
 python3 scripts/doc_section.py high-q "$section" "A real lever at its defaults (issue 42)"
-sed -n '/high-q:begin/,/high-q:end/p' docs/performance.md
+sed -n '/high-q:begin/,/high-q:end/p' "$(python3 scripts/doc_section.py --where high-q)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "PeakForce images" section of docs/performance.md (issue 61 §3): the whole
+# Regenerate the "PeakForce images" section of docs/performance/commands.md (issue 61 §3): the whole
 # command `afmdyn image --mode peakforce --setpoint 2nN --json --files none --threads 2` over
 # examples/sample-peakforce-blend.toml (background E* = 1 GPa, a stiff 3 GPa domain, a 5 nm
 # terrace) with the Amo & Garcia point mass of examples/probe-peakforce-amo-garcia.toml at
@@ -76,4 +76,4 @@ print("`bash scripts/perf-image-peakforce.sh` on this machine (2 cores, shared w
 print("<!-- pfimage:end -->")
 PY
 python3 scripts/doc_section.py pfimage "$section" "PeakForce images (issue 61)"
-sed -n '/pfimage:begin/,/pfimage:end/p' docs/performance.md
+sed -n '/pfimage:begin/,/pfimage:end/p' "$(python3 scripts/doc_section.py --where pfimage)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "PI images at size (issue 63)" section of docs/performance.md: the aims of
+# Regenerate the "PI images at size (issue 63)" section of docs/performance/commands.md: the aims of
 # issue 63 §2 measured on this machine (2 cores) — a 128 × 128 PI image at 1 Hz line rate on the
 # point mass (aim ≤ 10 min on 2 cores), its cost per drive period against the floor the scan
 # rate fixes (the lever's cycles per line), and the PI scan on a Dask LocalCluster of 2 worker
@@ -99,4 +99,4 @@ print(f"`bash scripts/perf-image-pi-large.sh` on this machine (2 cores; load ave
 print("<!-- image-pi-large:end -->")
 PY
 python3 scripts/doc_section.py image-pi-large "$section" "PI images at size (issue 63)"
-sed -n '/image-pi-large:begin/,/image-pi-large:end/p' docs/performance.md
+sed -n '/image-pi-large:begin/,/image-pi-large:end/p' "$(python3 scripts/doc_section.py --where image-pi-large)"

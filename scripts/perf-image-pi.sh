@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Images (PI feedback)" section of docs/performance.md (issue 46): the cost of
+# Regenerate the "Images (PI feedback)" section of docs/performance/commands.md (issue 46): the cost of
 # `afmdyn image --feedback pi` (each line scanned in the time domain, trace and retrace, under a
 # lock-in and a PI z controller updating once per drive period) per drive period, per pixel and
 # per line, at the lever's default settings (a pixel lasts 5 loop time constants 1/K_I), and the
@@ -57,4 +57,4 @@ section=$(mktemp)
     echo "<!-- image-pi:end -->"
 } > "$section"
 python3 scripts/doc_section.py image-pi "$section" "Images (PI feedback, issue 46)"
-sed -n '/image-pi:begin/,/image-pi:end/p' docs/performance.md
+sed -n '/image-pi:begin/,/image-pi:end/p' "$(python3 scripts/doc_section.py --where image-pi)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Images (ideal feedback)" section of docs/performance.md (issue 46): `afmdyn
+# Regenerate the "Images (ideal feedback)" section of docs/performance/commands.md (issue 46): `afmdyn
 # image` of examples/sample-blend.toml (polystyrene with a rubber domain and a 5 nm terrace: two
 # materials) over examples/probe-point-mass-dmt.toml at the setpoint 0.7, 64 × 64 and 256 × 256
 # pixels, and the same on the beam (N = 3) of examples/probe-beam-dmt.toml. Whole command
@@ -48,4 +48,4 @@ section=$(mktemp)
     echo "<!-- image:end -->"
 } > "$section"
 python3 scripts/doc_section.py image "$section" "Images (ideal feedback, issue 46)"
-sed -n '/image:begin/,/image:end/p' docs/performance.md
+sed -n '/image:begin/,/image:end/p' "$(python3 scripts/doc_section.py --where image)"

@@ -3,7 +3,7 @@
 --files none --json` per integrator (best of 3 wall times), and the final state's largest
 difference from the adaptive oracle at tolerance 1e-14, relative to the state's largest entry.
 Prints a Markdown table. Used for the decision on the exponential (Lawson) frame (issue 43;
-docs/performance.md).
+docs/performance/laws.md).
 
 Usage: python3 scripts/perf-integrators.py [AFMDYN_BIN] [KIND ...]
        (default: target/release/afmdyn; kinds taylor adaptive split)"""

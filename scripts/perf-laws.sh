@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Per forcing period, by law" section of docs/performance.md: wall time, steps and
+# Regenerate the "Per forcing period, by law" section of docs/performance/laws.md: wall time, steps and
 # events per period for every law at N = 1, 3 (and the linear law at N = 10, 20) — through
 # `advance` (no step observer) and through `advance_dyn` (an observer after every step) — the
 # exact propagator's build and shooting times, the wall time of the default continuation and
@@ -72,4 +72,4 @@ table=$(mktemp)
   echo "<!-- laws:end -->"
 } > "$table"
 python3 scripts/doc_section.py laws "$table" "Per forcing period, by law"
-sed -n '/laws:begin/,/laws:end/p' docs/performance.md
+sed -n '/laws:begin/,/laws:end/p' "$(python3 scripts/doc_section.py --where laws)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Tapping in liquid" section of docs/performance.md (issue 45): `afmdyn approach`
+# Regenerate the "Tapping in liquid" section of docs/performance/commands.md (issue 45): `afmdyn approach`
 # on examples/probe-water-beam.toml (a 450 × 50 × 2 µm silicon lever, k = 0.19 N/m, in water:
 # Sader's hydrodynamic loading of every mode, f1 = 3.4 kHz, Q1 = 2.4, over a 50 MPa
 # Kelvin–Voigt polymer; beam N = 3) with and without the branches, the point-mass model of the
@@ -72,4 +72,4 @@ section=$(mktemp)
     echo "<!-- liquid:end -->"
 } > "$section"
 python3 scripts/doc_section.py liquid "$section" "Tapping in liquid (issue 45)"
-sed -n '/liquid:begin/,/liquid:end/p' docs/performance.md
+sed -n '/liquid:begin/,/liquid:end/p' "$(python3 scripts/doc_section.py --where liquid)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "PeakForce tapping" section of docs/performance.md (issue 61): one steady tap
+# Regenerate the "PeakForce tapping" section of docs/performance/commands.md (issue 61): one steady tap
 # (`afmdyn peakforce --json`, the whole command: start-up, settling, Newton shooting with the
 # Floquet multipliers, the 4 096-point cycle, the DMT fits and the JSON document) at
 # f0/f_m = 100 on the ScanAsyst-Air-like example lever (examples/probe-peakforce-air.toml with
@@ -66,4 +66,4 @@ print("each in turn, medians; `bash scripts/perf-peakforce.sh` on this machine (
 print("<!-- peakforce:end -->")
 PY
 python3 scripts/doc_section.py peakforce "$section" "PeakForce tapping (issue 61)"
-sed -n '/peakforce:begin/,/peakforce:end/p' docs/performance.md
+sed -n '/peakforce:begin/,/peakforce:end/p' "$(python3 scripts/doc_section.py --where peakforce)"

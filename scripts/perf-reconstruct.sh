@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Force reconstruction" section of docs/performance.md (issue 60 item 8):
+# Regenerate the "Force reconstruction" section of docs/performance/commands.md (issue 60 item 8):
 # `afmdyn reconstruct` on a uniform CSV curve of 10^4 and 10^5 rows (a van der Waals shift from
 # 0.3 to 60 nm; whole command: reading, inversion, CSV, plot and document; best of 3), and at
 # the library level the sum before the FFT, the direct sum now and the FFT (cargo run --release
@@ -65,4 +65,4 @@ section=$(mktemp)
     echo "<!-- reconstruct:end -->"
 } > "$section"
 python3 scripts/doc_section.py reconstruct "$section" "Force reconstruction (issue 60)"
-sed -n '/reconstruct:begin/,/reconstruct:end/p' docs/performance.md
+sed -n '/reconstruct:begin/,/reconstruct:end/p' "$(python3 scripts/doc_section.py --where reconstruct)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Recording a run: afmdyn simulate" section of docs/performance.md: wall time per
+# Regenerate the "Recording a run: afmdyn simulate" section of docs/performance/recording.md: wall time per
 # drive period of `afmdyn simulate --periods 20000` (default parameters, N = 3, linear law, exact
 # propagator) with --files none (the summary only: energy balance, sections, events) and with the
 # default files (200 samples per period to NPY, events, sections, energy, plots), best of 5, against
@@ -63,4 +63,4 @@ PY
   echo "<!-- simulate:end -->"
 } > "$section"
 python3 scripts/doc_section.py simulate "$section" "Recording a run: afmdyn simulate"
-sed -n '/simulate:begin/,/simulate:end/p' docs/performance.md
+sed -n '/simulate:begin/,/simulate:end/p' "$(python3 scripts/doc_section.py --where simulate)"

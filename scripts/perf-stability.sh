@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "Shooting and continuation" section of docs/performance.md: one Newton shooting
+# Regenerate the "Shooting and continuation" section of docs/performance/analyses.md: one Newton shooting
 # solve of the period-1 orbit at N = 3 (`period_cost shoot`, as benches/stability.rs; best of 5
 # runs, each the best of 200 solves) and the continuation of the default period-1 branch over
 # Ω from 5 down to 1 (`period_cost continuation`, best of 5 runs, each the best of 3), with the
@@ -28,4 +28,4 @@ table=$(mktemp)
   echo "<!-- stability:end -->"
 } > "$table"
 python3 scripts/doc_section.py stability "$table" "Shooting and continuation"
-sed -n '/stability:begin/,/stability:end/p' docs/performance.md
+sed -n '/stability:begin/,/stability:end/p' "$(python3 scripts/doc_section.py --where stability)"

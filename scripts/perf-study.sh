@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerate the "Studies: sweeps and charts on all cores and on Dask" section of
-# docs/performance.md (issue 29): the default `afmdyn bifurcation` and a 100 × 50 `afmdyn chart`
+# docs/performance/commands.md (issue 29): the default `afmdyn bifurcation` and a 100 × 50 `afmdyn chart`
 # at N = 3 on 1 and 2 threads (wall time, speed-up, tasks per second, identical files), the
 # peak memory of a chart at 1× and 10× the cells, and the same chart through
 # `afmdyn.dask.chart` on a 2-worker LocalCluster against `afmdyn.chart(threads=2)`.
@@ -78,4 +78,4 @@ PY
   echo "<!-- study:end -->"
 } > "$section"
 python3 scripts/doc_section.py study "$section" "Studies: sweeps and charts on all cores and on Dask"
-sed -n '/study:begin/,/study:end/p' docs/performance.md
+sed -n '/study:begin/,/study:end/p' "$(python3 scripts/doc_section.py --where study)"

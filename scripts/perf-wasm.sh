@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the "WebAssembly against native" section of docs/performance.md (issue 47): µs per
+# Regenerate the "WebAssembly against native" section of docs/performance/commands.md (issue 47): µs per
 # forcing period of the engine compiled to wasm32 (crates/afmdyn-wasm, run under Node.js's V8 —
 # the engine of Chromium) against the same call compiled natively
 # (`afmdyn_wasm::advance_periods` from rest, default `auto` integrator, best of 3), for the
@@ -62,4 +62,4 @@ section=$(mktemp)
     echo "<!-- wasm:end -->"
 } > "$section"
 python3 scripts/doc_section.py wasm "$section" "WebAssembly against native (issue 47)"
-sed -n '/wasm:begin/,/wasm:end/p' docs/performance.md
+sed -n '/wasm:begin/,/wasm:end/p' "$(python3 scripts/doc_section.py --where wasm)"

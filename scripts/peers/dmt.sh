@@ -4,7 +4,7 @@
 # the point-mass DMT model against an independent C++ DOP853 (dmt_peer.cpp: dop853.f's method and
 # step control, switchings located on the dense output and polished by Newton, restart at each).
 #
-#   bash scripts/peers/dmt.sh        # prints the table, regenerates docs/performance.md's section
+#   bash scripts/peers/dmt.sh        # prints the table, regenerates docs/performance/laws.md's section
 #
 # 1. Builds afmdyn (cargo build --release) and the peer (g++ -O3 -march=native, standard library
 #    only).
@@ -25,7 +25,7 @@
 #    energy balance), and on the orbit. The peer's accepted and rejected steps, events,
 #    event-polish steps and vector-field evaluations per period; afmdyn's switchings per period
 #    from its --json summary (it does not print step counts).
-# 5. Prints the table and rewrites the part of docs/performance.md between
+# 5. Prints the table and rewrites the part of docs/performance/laws.md between
 #    <!-- dmt-peer:begin … --> and <!-- dmt-peer:end --> (scripts/doc_section.py); DMT_NO_DOCS=1
 #    leaves the docs alone. DMT_PROBE selects another point-mass DMT probe file.
 #
@@ -164,7 +164,7 @@ lines = [
 table = "\n".join(lines)
 print(table)
 if failed:
-    fail(f"agreement above {LIMIT:g}: {', '.join(failed)} (docs/performance.md left alone)")
+    fail(f"agreement above {LIMIT:g}: {', '.join(failed)} (docs/performance/laws.md left alone)")
 if write_docs:
     path = f"{tmp}/section.md"
     open(path, "w").write(table + "\n")

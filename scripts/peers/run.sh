@@ -3,8 +3,8 @@
 # (Boost.Odeint runge_kutta_dopri5, dense output, TOMS748 switchings: odeint_peer.cpp) and SciPy
 # (solve_ivp DOP853 with terminal events: scipy_peer.py) on the same model, at matched accuracy.
 #
-#   bash scripts/peers/run.sh            # N = 1 3 10 20, regenerates docs/performance.md
-#   PEER_NS="1 3" bash scripts/peers/run.sh   # other mode counts (docs/performance.md untouched)
+#   bash scripts/peers/run.sh            # N = 1 3 10 20, regenerates docs/performance/propagator.md
+#   PEER_NS="1 3" bash scripts/peers/run.sh   # other mode counts (docs/performance/propagator.md untouched)
 #
 # 1. Installs what is missing: libboost-dev and nlohmann-json3-dev (apt-get; root or sudo), NumPy
 #    and SciPy in the venv target/venv-peers (pip).
@@ -15,12 +15,12 @@
 #    τ = 40 agrees with afmdyn's to ≤ 1e-9 relative to the state norm, or until the peer stops
 #    improving (its round-off floor: then its best agreement and its own spread are reported);
 #    then times each peer at that tolerance.
-# 4. Prints the table and, for the default N list, rewrites the part of docs/performance.md
+# 4. Prints the table and, for the default N list, rewrites the part of docs/performance/propagator.md
 #    between <!-- peers:begin ... --> and <!-- peers:end -->.
 #
 # Exit status 1 when afmdyn disagrees with a peer (above 1e-9 and outside twice the peer's own
 # spread): the table is printed, the docs are left alone unless PEERS_ALLOW_UNMATCHED=1. Takes
-# about 9 minutes on 2 shared cores, most of it SciPy at N = 10 and 20. Details: docs/performance.md.
+# about 9 minutes on 2 shared cores, most of it SciPy at N = 10 and 20. Details: docs/performance/propagator.md.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 NS=${PEER_NS:-"1 3 10 20"}
@@ -221,11 +221,13 @@ print(table)
 if failed:
     print("\naccuracy agreement FAILED: " + "; ".join(failed), file=sys.stderr)
 if write_docs and (not failed or os.environ.get("PEERS_ALLOW_UNMATCHED") == "1"):
-    doc = open("docs/performance.md").read()
+    page = subprocess.run([sys.executable, "scripts/doc_section.py", "--where", "peers"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    doc = open(page).read()
     pat = re.compile(r"<!-- peers:begin.*?<!-- peers:end -->", re.S)
     if not pat.search(doc):
-        sys.exit("docs/performance.md has no <!-- peers:begin --> ... <!-- peers:end --> markers")
-    open("docs/performance.md", "w").write(pat.sub(lambda _: table, doc))
-    print("\ndocs/performance.md: peers section regenerated")
+        sys.exit(f"{page} has no <!-- peers:begin --> ... <!-- peers:end --> markers")
+    open(page, "w").write(pat.sub(lambda _: table, doc))
+    print(f"\n{page}: peers section regenerated")
 sys.exit(1 if failed else 0)
 PY
