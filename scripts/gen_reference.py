@@ -454,25 +454,29 @@ def stray(pages: Dict[Path, str]) -> List[Path]:
     return sorted(p for p in (REF / "commands").glob("*.md") if p not in pages)
 
 
+def write_or_check(files: Dict[Path, str], check: bool, by: str) -> int:
+    """Write ``files`` (and remove the stray command pages), or with ``check`` list those that
+    differ from their text, naming the generator ``by`` to run: 1 when any is stale."""
+    if check:
+        stale = [p for p, t in files.items() if not p.exists() or p.read_text() != t]
+        stale += stray(files)
+        for p in stale:
+            print(f"{p.relative_to(ROOT)} is stale: run python3 {by}", file=sys.stderr)
+        return 1 if stale else 0
+    for p in stray(files):
+        p.unlink()
+    for p, t in files.items():
+        p.parent.mkdir(exist_ok=True)
+        p.write_text(t)
+    return 0
+
+
 def main(argv: List[str]) -> int:
     if "--help-from" in argv:
         binary = argv[argv.index("--help-from") + 1]
         HELP.write_text(help_snapshot(lambda args: subprocess.run(
             [binary, *args], capture_output=True, text=True, check=True).stdout))
-    pages = generate()
-    if "--check" in argv:
-        stale = [p for p, t in pages.items() if not p.exists() or p.read_text() != t]
-        stale += stray(pages)
-        for p in stale:
-            print(f"{p.relative_to(ROOT)} is stale: run python3 scripts/gen_reference.py",
-                  file=sys.stderr)
-        return 1 if stale else 0
-    for p in stray(pages):
-        p.unlink()
-    for p, t in pages.items():
-        p.parent.mkdir(exist_ok=True)
-        p.write_text(t)
-    return 0
+    return write_or_check(generate(), "--check" in argv, "scripts/gen_reference.py")
 
 
 if __name__ == "__main__":

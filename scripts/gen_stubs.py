@@ -209,19 +209,7 @@ def main() -> int:
     for path in LAW_LISTS[1:]:
         new[path] = with_laws(path.read_text())
     new.update(gen_reference.generate())
-    if "--check" in sys.argv[1:]:
-        stale = [p for p, t in new.items() if not p.exists() or t != p.read_text()]
-        stale += gen_reference.stray(new)
-        for p in stale:
-            print(f"{p.relative_to(ROOT)} is stale: run python3 scripts/gen_stubs.py",
-                  file=sys.stderr)
-        return 1 if stale else 0
-    for path in gen_reference.stray(new):
-        path.unlink()
-    for path, t in new.items():
-        path.parent.mkdir(exist_ok=True)
-        path.write_text(t)
-    return 0
+    return gen_reference.write_or_check(new, "--check" in sys.argv[1:], "scripts/gen_stubs.py")
 
 
 if __name__ == "__main__":

@@ -25,15 +25,22 @@ fi
 bash scripts/explorer.sh build || fail "building the site"
 cargo build -q --release -p afmdyn-cli || fail "native build"
 
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+# serve DIR on a free loopback port in the background, its log in LOG, until it answers: the
+# port in $served, the server's pid added to $servers (killed on exit)
+servers=""
+serve() {
+    served=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+    python3 -m http.server "$served" --bind 127.0.0.1 --directory "$1" > "$2" 2>&1 &
+    servers="$servers $!"
+    for _ in $(seq 50); do
+        python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$served/')" 2> /dev/null && break
+        sleep 0.1
+    done
+}
 log=$(mktemp)
-python3 -m http.server "$port" --bind 127.0.0.1 --directory "$TARGET/explorer/site" > "$log" 2>&1 &
-server=$!
-trap 'kill "$server" 2> /dev/null; rm -f "$log" "$log".*' EXIT
-for _ in $(seq 50); do
-    python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/')" 2> /dev/null && break
-    sleep 0.1
-done
+trap 'kill $servers 2> /dev/null; rm -f "$log" "$log".*' EXIT
+serve "$TARGET/explorer/site" "$log"
+port=$served
 # each wait in the test is bounded (120 s); the whole run too
 timeout 900 node explorer/tests/browser.mjs --url "http://127.0.0.1:$port/" \
     --bin "$TARGET/release/afmdyn" --chromium "$chromium" --out "$TARGET/explorer" | tee "$log.explorer"
@@ -52,14 +59,8 @@ if [ ! -e "$book/index.html" ]; then
     bash scripts/build-book.sh "$book" || echo "the book's build failed or warned"
 fi
 if [ -e "$book/index.html" ]; then
-    book_port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-    python3 -m http.server "$book_port" --bind 127.0.0.1 --directory "$book" > "$log.book" 2>&1 &
-    book_server=$!
-    trap 'kill "$server" "$book_server" 2> /dev/null; rm -f "$log" "$log".*' EXIT
-    for _ in $(seq 50); do
-        python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$book_port/')" 2> /dev/null && break
-        sleep 0.1
-    done
+    serve "$book" "$log.book"
+    book_port=$served
     timeout 120 node explorer/tests/book.mjs --url "http://127.0.0.1:$book_port/" --chromium "$chromium" |
         tee "$log.pages"
     book_code=${PIPESTATUS[0]}
