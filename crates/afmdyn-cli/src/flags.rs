@@ -174,7 +174,7 @@ pub struct SimulateFlags {
     #[arg(long, default_value = "200", help = "Samples per drive period, 1..=100000.")]
     pub samples_per_period: usize,
     /// `--energy-balance`: the request's `energy_balance`.
-    #[arg(long, help = "Audit the energy balance of every drive period (energy.csv, the series' energy_* variables and the summary's energy_residual, whose residual checks the integration); off by default, as it takes a quarter to a half of the run's time (docs/performance.md).")]
+    #[arg(long, help = "Audit the energy balance of every drive period (energy.csv, the series' energy_* variables and the summary's energy_residual, whose residual checks the integration); off by default, as it takes a quarter to a half of the run's time (docs/performance/recording.md).")]
     pub energy_balance: bool,
     /// The flags of the nested `integrator`.
     #[command(flatten)]

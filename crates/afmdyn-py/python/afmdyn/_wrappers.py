@@ -81,7 +81,7 @@ def simulate(
         energy_balance: Audit the energy balance of every drive period (``energy.csv``, the
             series' ``energy_*`` variables and the summary's ``energy_residual``, whose
             residual checks the integration); off by default, as it takes a quarter to a
-            half of the run's time (``docs/performance.md``).
+            half of the run's time (``docs/performance/recording.md``).
         initial: The initial state (2N values); ``None``: rest. An :class:`Attractor` or
             :class:`Orbit` is also taken (its state at drive phase 0).
         integrator: The time integrator: ``auto`` (the exact propagator for the linear law,

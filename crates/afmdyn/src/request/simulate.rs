@@ -41,7 +41,8 @@ pub struct SimulateRequest {
     pub samples_per_period: usize,
     /// Audit the energy balance of every drive period (`energy.csv`, the series' `energy_*`
     /// variables and the summary's `energy_residual`, whose residual checks the integration);
-    /// off by default, as it takes a quarter to a half of the run's time (`docs/performance.md`).
+    /// off by default, as it takes a quarter to a half of the run's time
+    /// (`docs/performance/recording.md`).
     #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
     pub energy_balance: bool,
     /// The integrator.
