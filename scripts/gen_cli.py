@@ -213,6 +213,15 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "args": {"data": 'required = true, value_name = "FILE.csv"',
                  "range": 'value_name = "LO,HI"', "approach_rows": 'value_name = "N"'},
     },
+    # `fit-map`: the map is read from `--data FILE`
+    "FitMapFlags": {
+        "file": "afm",
+        "schema": "fit_map",
+        "words": ["x", "y", "height", "force", "segment", "time"],
+        "order": ["data", "fit", "segment", "range", "threads"],
+        "args": {"data": 'required = true, value_name = "FILE"',
+                 "range": 'value_name = "LO,HI"'},
+    },
     "LyapunovFlags": {
         "schema": "lyapunov",
         "given": {"initial": "Option<Vec<f64>>"},

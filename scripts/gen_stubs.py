@@ -55,6 +55,7 @@ RUN = [
     ("reconstruct", "reconstruct"),
     ("peakforce", "peakforce"),
     ("fit", "fit"),
+    ("fit_map", "fit_map"),
 ]
 #: the studies run into a store through ``_afmdyn.run_stored`` (the library's
 #: ``study::stored::parse``) and their schema files
@@ -65,6 +66,7 @@ STORED = [
     ("approach", "approach"),
     ("bimodal", "approach"),
     ("resonance", "resonance"),
+    ("fit_map", "fit_map"),
 ]
 #: requests with a stub but no compiled function of their own (the chart's study takes JSON)
 OTHERS = ["chart"]

@@ -5,7 +5,7 @@
 
 use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{FitRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
+use afmdyn::request::{FitMapRequest, FitRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`ImageRequest`]'s fields (generated from its schema).
@@ -157,6 +157,42 @@ impl FitFlags {
             range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
             segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
             ..FitRequest::default()
+        })
+    }
+}
+
+/// The flags of [`FitMapRequest`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct FitMapFlags {
+    /// `--data`: the request's `data`.
+    #[arg(long, required = true, value_name = "FILE", help = "The map, read through the bounded reader and streamed (one curve at a time): a long-format CSV with the columns x, y (m, the curve's position), height (m, the piezo height, decreasing into the sample), force (N, repulsion positive) and optionally segment (0 approach, 1 retract) and time (s), a curve's rows consecutive; or the NetCDF file afmdyn.export_map writes (from any map afmformats reads, with each curve's grid index and spring constant).")]
+    pub data: Option<String>,
+    /// `--fit`: the request's `fit`.
+    #[arg(long, default_values = ["sample.youngs_modulus", "contact_point", "baseline"], value_delimiter = ',', help = "The parameters fitted at every curve, by their probe keys (as --fit's: sample.youngs_modulus, tip.radius, contact_point, baseline, sample.hamaker (DMT), sample.adhesion_energy (JKR)); the others held at the probe's values. Default sample.youngs_modulus, contact_point and baseline, as nanite fits a map.")]
+    pub fit: Vec<String>,
+    /// `--segment`: the request's `segment`.
+    #[arg(long, value_parser = ["approach", "retract", "whole"], help = "The segment fitted: approach (the default), retract or whole.")]
+    pub segment: Option<String>,
+    /// `--range`: the request's `range`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "LO,HI", help = "The range of tip positions fitted [lo, hi] (m, relative to each curve's contact point found by the deviation from the baseline, as nanite's range_x); default the whole segment. With --probe a unit may follow (20nm).")]
+    pub range: Option<Vec<Quantity>>,
+    /// `--threads`: the request's `threads`.
+    #[arg(long, help = "Worker threads (default: all cores); the results do not depend on it.")]
+    pub threads: Option<usize>,
+}
+
+impl FitMapFlags {
+    /// The [`FitMapRequest`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`), or a list of another length than its field's.
+    pub fn request(&self, si: bool) -> Result<FitMapRequest, CliError> {
+        Ok(FitMapRequest {
+            data: self.data.clone(),
+            fit: self.fit.clone(),
+            range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
+            segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
+            threads: self.threads,
         })
     }
 }

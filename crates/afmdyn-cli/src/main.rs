@@ -33,6 +33,7 @@ mod cmd_approach;
 mod cmd_basins;
 mod cmd_chart;
 mod cmd_fit;
+mod cmd_fit_map;
 mod cmd_fm;
 mod cmd_image;
 mod cmd_modes;
@@ -111,6 +112,8 @@ enum Command {
     Peakforce(cmd_peakforce::PeakForceArgs),
     /// Fit a measured force curve (Hertz, DMT, JKR, SLS on a dwell) or an AM/FM curve: estimates, intervals, warnings
     Fit(cmd_fit::FitArgs),
+    /// Fit every curve of a force-volume or QI map: modulus map, topography, flags per curve
+    FitMap(cmd_fit_map::FitMapArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
     /// AM-AFM image of a heterogeneous sample (ideal or PI feedback): height, phase, E_dis maps
@@ -138,6 +141,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Fm(a) => cmd_fm::fm(&a),
         Command::Peakforce(a) => cmd_peakforce::peakforce(&a),
         Command::Fit(a) => cmd_fit::fit(&a),
+        Command::FitMap(a) => cmd_fit_map::fit_map(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
         Command::Image(a) => cmd_image::image_cmd(&a),
     }

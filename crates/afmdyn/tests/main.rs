@@ -33,6 +33,8 @@ mod fit_fm;
 mod fit_jkr;
 #[cfg(feature = "files")]
 mod fit_lever;
+#[cfg(all(feature = "files", feature = "parallel"))]
+mod fit_map;
 #[cfg(feature = "files")]
 mod fit_profiles;
 mod fit_sls;

@@ -90,6 +90,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
             schema::<afmdyn::request::image_options::ImageOptions>("image_options"),
         ),
         ("fit", schema::<afmdyn::request::FitRequest>("fit")),
+        (
+            "fit_map",
+            schema::<afmdyn::request::FitMapRequest>("fit_map"),
+        ),
     ]
 }
 

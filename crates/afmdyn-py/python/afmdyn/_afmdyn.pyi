@@ -446,6 +446,18 @@ FitRequest = TypedDict(
     total=False,
 )
 
+FitMapRequest = TypedDict(
+    "FitMapRequest",
+    {
+        "data": Optional[str],  # default null
+        "fit": List[str],  # default ["sample.youngs_modulus", "contact_point", "baseline"]
+        "range": Optional[List[float]],  # default null
+        "segment": Optional[Literal["approach", "retract", "whole"]],  # default null
+        "threads": Optional[int],  # default null
+    },
+    total=False,
+)
+
 BifurcationRequest = TypedDict(
     "BifurcationRequest",
     {
@@ -651,6 +663,15 @@ def run(
 
 @overload
 def run(
+    name: Literal["fit_map"],
+    request: Optional[FitMapRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
     name: str,
     request: Optional[Dict[str, Any]] = None,
     params: Optional[Params] = None,
@@ -717,6 +738,17 @@ def run_stored(
 def run_stored(
     name: Literal["resonance"],
     request: Optional[ResonanceRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: Literal["fit_map"],
+    request: Optional[FitMapRequest] = None,
     params: Optional[Params] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,

@@ -67,6 +67,9 @@ pub enum InputKind {
     CurveCsv,
     /// A curve's JSON document (`afmdyn reconstruct --fm fm.json`, `--am approach.json`).
     CurveDocument,
+    /// A force map (`afmdyn fit-map --data map.csv`, a long-format CSV, or the NetCDF file
+    /// `afmdyn.export_map` writes): streamed, so its cap is a store's.
+    ForceMap,
     /// A CSV file of a sweep's store read back (`--resume`: `.bifurcation.partial.csv`, and
     /// `bifurcation.csv` when the sweep finished).
     Store,
@@ -89,7 +92,7 @@ impl InputKind {
             InputKind::HeightMapCsv => super::caps::MAX_CSV_BYTES,
             InputKind::HeightMapNpy => super::caps::MAX_NPY_BYTES,
             InputKind::CurveDocument => MAX_INPUT_DOCUMENT_BYTES,
-            InputKind::Store | InputKind::StoreRecords => MAX_STORE_BYTES,
+            InputKind::Store | InputKind::StoreRecords | InputKind::ForceMap => MAX_STORE_BYTES,
             InputKind::StoreLedger => MAX_LEDGER_BYTES,
             InputKind::Lock => MAX_LOCK_BYTES,
         }
@@ -103,6 +106,7 @@ impl InputKind {
             InputKind::Overlay
             | InputKind::HeightMapCsv
             | InputKind::CurveCsv
+            | InputKind::ForceMap
             | InputKind::Store => Some(MAX_CSV_LINE_BYTES),
             InputKind::StoreRecords => Some(MAX_STORE_LINE_BYTES),
             _ => None,
@@ -130,6 +134,7 @@ impl InputKind {
             InputKind::HeightMapNpy => "a height map NPY",
             InputKind::CurveCsv => "a curve CSV",
             InputKind::CurveDocument => "a curve document",
+            InputKind::ForceMap => "a force map",
             InputKind::Store => "a store's CSV",
             InputKind::StoreRecords => "a store's records",
             InputKind::StoreLedger => "a store's ledger",

@@ -11,6 +11,7 @@ pub(crate) mod caps;
 pub mod curve_file;
 #[cfg(feature = "files")]
 pub mod dir_lock;
+pub mod force_map;
 pub mod height_map;
 pub mod input;
 

@@ -382,7 +382,9 @@ pub(crate) fn with_si(
 
 /// The keys whose `null` is a documented state, not a missing value: a nonperiodic motion's
 /// `period` and `multipliers`, a periodic one's `lyapunov`, an exponent no cell gave.
-const NULL_BY_DESIGN: [&str; 6] = [
+const NULL_BY_DESIGN: [&str; 7] = [
+    // a fitted map's curves: a curve's missing estimate is its flag's (`fit-map`)
+    "curves",
     "period",
     "multipliers",
     "lyapunov",

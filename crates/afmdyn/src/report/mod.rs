@@ -390,6 +390,7 @@ pub(crate) mod curve_layout;
 mod curve_table;
 mod curves;
 mod documents;
+pub mod fit_map;
 pub mod image;
 pub(crate) mod image_layout;
 pub mod present;

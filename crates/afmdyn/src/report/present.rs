@@ -15,6 +15,7 @@ pub(crate) mod converge;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fit;
+pub(crate) mod fit_map;
 pub mod fm;
 pub mod image;
 pub(crate) mod maps;

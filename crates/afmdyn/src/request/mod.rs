@@ -39,6 +39,7 @@ pub mod fm;
 pub use crate::io::height_map as height_map_file;
 pub mod fit;
 pub(crate) mod fit_dynamic;
+pub mod fit_map;
 pub(crate) mod fit_result;
 pub mod image;
 pub mod image_job;
@@ -74,6 +75,7 @@ pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};
 pub use fit::FitRequest;
+pub use fit_map::FitMapRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};

@@ -22,7 +22,7 @@ use serde::de::{Deserialize, Deserializer};
 use serde_json::Value;
 
 /// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 17] = [
+pub const NAMES: [&str; 18] = [
     "modes",
     "simulate",
     "converge",
@@ -40,6 +40,7 @@ pub const NAMES: [&str; 17] = [
     "reconstruct",
     "peakforce",
     "fit",
+    "fit_map",
 ];
 
 /// An analysis request parsed by name ([`parse`]): the request of its name, as data. Its
@@ -87,6 +88,8 @@ pub(crate) enum Parsed {
     PeakForce(PeakForceRequest),
     /// `fit`.
     Fit(FitRequest),
+    /// `fit_map`.
+    FitMap(super::FitMapRequest),
 }
 
 /// `$body` on the request `$r` of every variant of a [`NamedRequest`]'s `Parsed` but `simulate` (its
@@ -112,6 +115,7 @@ macro_rules! each_request {
             $crate::request::named::Parsed::Reconstruct($r) => $body,
             $crate::request::named::Parsed::PeakForce($r) => $body,
             $crate::request::named::Parsed::Fit($r) => $body,
+            $crate::request::named::Parsed::FitMap($r) => $body,
             $crate::request::named::Parsed::Simulate($s) => $simulate,
             $crate::request::named::Parsed::ReconstructDocument($f) => $document,
         }
@@ -186,6 +190,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "reconstruct_document" => door(d, N::ReconstructDocument),
         "peakforce" => door(d, N::PeakForce),
         "fit" => door(d, N::Fit),
+        "fit_map" => door(d, N::FitMap),
         _ => Ok(None),
     }
 }
@@ -216,6 +221,7 @@ pub fn default_request(name: &str) -> Option<Value> {
         "fm" => v::<FmRequest>(),
         "peakforce" => v::<super::PeakForceRequest>(),
         "fit" => v::<super::FitRequest>(),
+        "fit_map" => v::<super::FitMapRequest>(),
         _ => None,
     }
 }

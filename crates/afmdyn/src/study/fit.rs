@@ -31,7 +31,8 @@ use super::fit_result::{bounds, intervals_method};
 
 impl FitRequest {
     /// The curve of `height` and `force` (and the sls law's `time`) preprocessed with the
-    /// lever's spring constant `k`, its approach `approach_rows` long when given.
+    /// lever's spring constant `k`, its approach `approach_rows` long when given (the
+    /// request's, or a map curve's segments).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `approach_rows` beyond the curve's rows, or `time` for
@@ -43,9 +44,10 @@ impl FitRequest {
         force: &[f64],
         time: Option<Vec<f64>>,
         k: f64,
+        approach_rows: Option<usize>,
     ) -> Result<Preprocessed, SimError> {
         let mut curve = preprocess(height, force, k);
-        if let Some(n) = self.approach_rows {
+        if let Some(n) = approach_rows {
             if !(1..=force.len()).contains(&n) {
                 return Err(bad(
                     "approach_rows",
@@ -186,60 +188,70 @@ fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String> {
     slips.into_iter().flatten().collect()
 }
 
-/// A contact point fitted more than the heights' span outside them: the fit has not found the
-/// contact (issue 77 item 4: a curve in nm and nN gave −1445 m).
-fn contact_point_warning(height: &[f64], contact: f64) -> Option<String> {
-    let h = crate::request::quantity::span(height);
-    let (lo, hi) = crate::request::quantity::extent(height);
+/// A contact point fitted more than the tip positions' span outside them (both after the
+/// preprocessing's offset): the fit has not found the contact (issue 77 item 4: a curve in nm
+/// and nN gave −1445 m).
+fn contact_point_warning(tip: &[f64], contact: f64) -> Option<String> {
+    let h = crate::request::quantity::span(tip);
+    let (lo, hi) = crate::request::quantity::extent(tip);
     (contact < lo - h || contact > hi + h).then(|| {
         format!(
-            "contact_point = {contact:.4e} m lies far outside the heights measured ({lo:.4e} to \
-             {hi:.4e} m): the fit has not found the contact; check the columns' units and the \
+            "contact_point = {contact:.4e} m lies far outside the tip positions measured \
+             ({lo:.4e} to {hi:.4e} m, after the preprocessing's offset): the fit has not found the contact; check the columns' units and the \
              curve's segment"
         )
     })
 }
 
-impl Analysis for FitRequest {
-    type Output = FitResult;
-    fn convergence(&self, r: &FitResult) -> Convergence {
-        Convergence::of("minimiser", usize::from(r.outcome.converged), 1)
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
-        if let Some(data) = crate::request::fit_dynamic::read_am_data(self.data.as_deref())? {
-            // `range` of a dynamic curve: the piezo positions z fitted
-            let data = match self.range {
-                Some(range) => data.within(range),
-                None => data,
-            };
-            return super::fit_dynamic::execute(
-                &self.fit,
-                self.fit == FitRequest::default().fit,
-                self.profiles.unwrap_or(false),
-                model,
-                data,
-                progress,
-            );
-        }
-        let law = self.check(model)?;
-        let (height, force, sigma, time) = self.columns()?;
+/// One measured force curve: its piezo heights (m), forces (N), their σ (N) and the rows'
+/// times (s), the lever's spring constant (N/m) and, where the instrument records its
+/// segments, the number of approach rows.
+pub(crate) struct Curve<'a> {
+    /// The piezo heights (m).
+    pub height: &'a [f64],
+    /// The forces (N).
+    pub force: &'a [f64],
+    /// The forces' standard deviations (N).
+    pub sigma: Option<&'a [f64]>,
+    /// The rows' times (s).
+    pub time: Option<Vec<f64>>,
+    /// The lever's spring constant k (N/m).
+    pub spring_constant: f64,
+    /// The approach's rows (the instrument's segments); `None`: up to the lowest height.
+    pub approach_rows: Option<usize>,
+}
+
+impl FitRequest {
+    /// Fit `curve` with the request's options and the registry's `law` (checked,
+    /// [`FitRequest::check`]), started from and holding the probe's sample `s`, its intervals
+    /// walked as `walk` says (none: Wald's): one curve of `fit`, or of a map's `fit-map`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the column, `approach_rows`, `range` or `segment` that
+    /// leaves too few rows, or the probe value missing; [`SimError::Cancelled`].
+    pub(crate) fn fit_curve(
+        &self,
+        law: LawKind,
+        s: &SampleInputs,
+        c: Curve<'_>,
+        walk: Option<ProfileWalk>,
+        progress: &Progress,
+    ) -> Result<FitResult, SimError> {
         // (the times matter, and are checked, for the sls law only)
-        let time = time.filter(|_| law == LawKind::Sls);
-        check_columns(&height, &force, sigma.as_deref(), time.as_deref())?;
-        let probe = model.probe.as_ref().expect("checked");
-        let k = probe.calibration.spring_constant;
-        let s = probe.sample_inputs;
-        let curve = self.preprocessed(law, &height, &force, time, k)?;
+        let time = c.time.filter(|_| law == LawKind::Sls);
+        check_columns(c.height, c.force, c.sigma, time.as_deref())?;
+        let k = c.spring_constant;
+        let curve = self.preprocessed(law, c.height, c.force, time, k, c.approach_rows)?;
         let segment = self.segment_of(law);
         let fit = self.fitted(law);
         let rows = fit_rows(&curve, segment, self.range, fit.len())?;
         let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
         let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
-        let sig: Option<Vec<f64>> = sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
+        let sig: Option<Vec<f64>> = c.sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
         let names = force_curve::parameter_names(law)
             .unwrap_or_default()
             .to_vec();
-        let params = start_values(&names, &s, &x, &y)?;
+        let params = start_values(&names, s, &x, &y)?;
         let fitted: Vec<bool> = names.iter().map(|n| fit.iter().any(|f| f == n)).collect();
         let fixed: Vec<Option<f64>> = params
             .iter()
@@ -282,18 +294,20 @@ impl Analysis for FitRequest {
             y: &y,
             sigma: sig.as_deref(),
         };
-        let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
         let mut outcome = fit_cancellable(m, &obs, &params, &fixed, walk, progress)?;
         if let Some(model) = &sls {
             outcome
                 .warnings
                 .extend(sls_start_warning(model, &outcome.values));
         }
-        outcome.warnings.extend(data_warnings(&height, &force, k));
+        outcome.warnings.extend(data_warnings(c.height, c.force, k));
         let contact = names.iter().position(|n| *n == CONTACT_POINT);
+        // the contact point is a tip position after the preprocessing's offset: held against
+        // those, not the file's piezo heights (an instrument's are absolute: 18–23 µm)
+        let tip = &curve.tip_position;
         outcome
             .warnings
-            .extend(contact.and_then(|i| contact_point_warning(&height, outcome.values[i])));
+            .extend(contact.and_then(|i| contact_point_warning(tip, outcome.values[i])));
         Ok(FitResult {
             law,
             spring_constant: k,
@@ -304,6 +318,43 @@ impl Analysis for FitRequest {
             outcome,
             dynamic: None,
         })
+    }
+}
+
+impl Analysis for FitRequest {
+    type Output = FitResult;
+    fn convergence(&self, r: &FitResult) -> Convergence {
+        Convergence::of("minimiser", usize::from(r.outcome.converged), 1)
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
+        if let Some(data) = crate::request::fit_dynamic::read_am_data(self.data.as_deref())? {
+            // `range` of a dynamic curve: the piezo positions z fitted
+            let data = match self.range {
+                Some(range) => data.within(range),
+                None => data,
+            };
+            return super::fit_dynamic::execute(
+                &self.fit,
+                self.fit == FitRequest::default().fit,
+                self.profiles.unwrap_or(false),
+                model,
+                data,
+                progress,
+            );
+        }
+        let law = self.check(model)?;
+        let (height, force, sigma, time) = self.columns()?;
+        let probe = model.probe.as_ref().expect("checked");
+        let curve = Curve {
+            height: &height,
+            force: &force,
+            sigma: sigma.as_deref(),
+            time,
+            spring_constant: probe.calibration.spring_constant,
+            approach_rows: self.approach_rows,
+        };
+        let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
+        self.fit_curve(law, &probe.sample_inputs, curve, walk, progress)
     }
     fn report(&self, _: &Resolved, r: &FitResult) -> Result<Value, SimError> {
         Ok(document(self, r))

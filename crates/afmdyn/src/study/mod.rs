@@ -61,6 +61,7 @@ pub(crate) mod checkpoint_file;
 mod datasets;
 pub(crate) mod fit;
 pub(crate) mod fit_dynamic;
+pub mod fit_map;
 pub(crate) mod fit_result;
 pub(crate) mod fm;
 pub mod global_continuation;

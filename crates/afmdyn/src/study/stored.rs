@@ -3,7 +3,7 @@
 //! by the testing hook `abort_after` — and finished to the request's typed output): the one
 //! path of the command line's door and of Python's `run_stored`. The studies a front end runs
 //! by name ([`parse`]: `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`,
-//! `resonance`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
+//! `resonance`, `fit_map`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
 //! ([`Prepared::run`]) to the outcome the one door gives for the same request
 //! (`super::named::outcome`).
 
@@ -126,7 +126,7 @@ impl<'a> Storage<'a> {
     ///
     /// # Errors
     /// The store's and the study's.
-    fn records<S, R>(
+    pub(crate) fn records<S, R>(
         &self,
         study: &S,
         open: fn(&DirLock) -> TaskStore<'_, Lines<R>>,
@@ -487,6 +487,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
             spec: None,
         }),
         "resonance" => held(ResonanceRequest::deserialize(d)?),
+        "fit_map" => held(crate::request::FitMapRequest::deserialize(d)?),
         _ => return Ok(None),
     }))
 }

@@ -13,6 +13,7 @@ pub(crate) mod estimates;
 pub(crate) mod fm_curve;
 pub mod force_curve;
 pub(crate) mod least_squares;
+pub mod map;
 pub(crate) mod orbit_param;
 pub mod profile;
 pub mod sensitivity;

@@ -1,0 +1,136 @@
+//! `fit-map`: every curve of a force-volume or QI map fitted as `fit` fits one
+//! ([`super::FitRequest`]'s options, [`crate::analysis::fit::force_curve`]'s model), the
+//! results laid on the map's grid — the request the command line (`afmdyn fit-map`) and
+//! Python (`afmdyn.fit_map`) share: its map file, its options, their checks and its declared
+//! cost. Everything is SI (m, N, Pa).
+
+use super::costs::OPERATION_WORK;
+use super::fit::{bad, FitRequest, FitSegment};
+use super::fit_dynamic::fit_evaluations;
+use super::limits::Cost;
+use super::run::{Request, Resolved};
+use crate::analysis::fit::force_curve::{BASELINE, CONTACT_POINT, YOUNGS_MODULUS};
+use crate::error::SimError;
+use serde::{Deserialize, Serialize};
+
+/// `fit-map`: the map (`data`, a file), the parameters fitted at every curve (`fit`, probe
+/// keys), the segment and the range of tip positions fitted, and the worker threads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct FitMapRequest {
+    /// The map, read through the bounded reader and streamed (one curve at a time): a
+    /// long-format CSV with the columns `x`, `y` (m, the curve's position), `height` (m, the
+    /// piezo height, decreasing into the sample), `force` (N, repulsion positive) and
+    /// optionally `segment` (0 approach, 1 retract) and `time` (s), a curve's rows
+    /// consecutive; or the NetCDF file `afmdyn.export_map` writes (from any map afmformats
+    /// reads, with each curve's grid index and spring constant).
+    pub data: Option<String>,
+    /// The parameters fitted at every curve, by their probe keys (as `fit`'s:
+    /// `sample.youngs_modulus`, `tip.radius`, `contact_point`, `baseline`, `sample.hamaker`
+    /// (DMT), `sample.adhesion_energy` (JKR)); the others held at the probe's values. Default
+    /// `sample.youngs_modulus`, `contact_point` and `baseline`, as nanite fits a map.
+    pub fit: Vec<String>,
+    /// The segment fitted: `approach` (the default), `retract` or `whole`.
+    pub segment: Option<FitSegment>,
+    /// The range of tip positions fitted [lo, hi] (m, relative to each curve's contact point
+    /// found by the deviation from the baseline, as nanite's `range_x`); default the whole
+    /// segment.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+    pub range: Option<[f64; 2]>,
+    /// Worker threads (default: all cores); the results do not depend on it.
+    pub threads: Option<usize>,
+}
+
+impl Default for FitMapRequest {
+    fn default() -> Self {
+        FitMapRequest {
+            data: None,
+            fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into(), BASELINE.into()],
+            segment: None,
+            range: None,
+            threads: None,
+        }
+    }
+}
+
+/// The bytes the index keeps of a curve, and a curve's record (its estimates, flag and reason).
+const CURVE_BYTES: f64 = 1024.0;
+
+/// The bytes of one row of a curve under way (its columns, the preprocessed curve, the
+/// Jacobian and the residuals: `fit`'s 900).
+const ROW_BYTES: f64 = 900.0;
+
+impl FitMapRequest {
+    /// The map file's path.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `data` when it is missing.
+    pub fn path(&self) -> Result<&str, SimError> {
+        self.data.as_deref().ok_or_else(|| {
+            bad(
+                "data",
+                "missing",
+                "a map is needed: a long-format CSV (x, y, height, force) or the NetCDF file \
+                 afmdyn.export_map writes"
+                    .into(),
+            )
+        })
+    }
+
+    /// The request each curve is fitted with: `fit`'s options, its profiles off (each
+    /// estimate's interval is Wald's, ±1.96 standard errors).
+    pub(crate) fn curve_request(&self) -> FitRequest {
+        FitRequest {
+            data: self.data.clone(),
+            fit: self.fit.clone(),
+            segment: self.segment,
+            range: self.range,
+            profiles: Some(false),
+            ..FitRequest::default()
+        }
+    }
+
+    /// The map indexed (one streamed pass through its file).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `data` and the file's problem.
+    pub(crate) fn index(&self) -> Result<crate::io::force_map::ForceMap, SimError> {
+        let path = self.path()?;
+        crate::io::force_map::ForceMap::index(std::path::Path::new(path))
+            .map_err(|e| bad("data", path, e.to_string()))
+    }
+}
+
+impl Request for FitMapRequest {
+    const COST_ADVICE: &'static str = "fit a part of the map, or curves of fewer rows";
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.path()?;
+        super::limits::check_threads(self.threads)?;
+        self.curve_request().check(model).map(|_| ())
+    }
+    fn name(&self) -> &'static str {
+        "fit_map"
+    }
+    /// A map's curves use the probe's spring constant (where the map has none), tip and
+    /// sample only.
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Static
+    }
+    /// Measured on the map's index: each curve's record and index entry, one curve under way
+    /// per worker thread, and each row's evaluations.
+    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+        let (curves, rows, longest) = {
+            let map = self.index()?;
+            let rows: usize = map.curves.iter().map(|c| c.rows).sum();
+            (map.curves.len() as f64, rows as f64, map.max_rows() as f64)
+        };
+        let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
+        let threads = self.threads.unwrap_or_else(cores) as f64;
+        let n = self.fit.len().max(1);
+        Ok(Cost {
+            bytes: super::costs::MODEL_BYTES + curves * CURVE_BYTES + threads * longest * ROW_BYTES,
+            work: rows * OPERATION_WORK * fit_evaluations(n, None),
+        })
+    }
+}
