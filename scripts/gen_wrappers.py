@@ -99,6 +99,13 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
                 "fit": ("Optional[Sequence[str]]", "None"),
                 "range": ("Optional[Tuple[float, float]]", "None")},
             "own": [("curve", "int", "0")] + PROGRESS}),
+        "fit_map": ("fit_map", "_fit_map", "xr.Dataset", {
+            "rename": {"range": "fit_range"},
+            "override": {
+                "data": ('Union[str, "os.PathLike[str]", Sequence[Any], None]', "None"),
+                "fit": ("Optional[Sequence[str]]", "None"),
+                "range": ("Optional[Tuple[float, float]]", "None")},
+            "own": STORE_KW + PROGRESS}),
         "image": ("image", "_image", "xr.Dataset", {**IMAGE, "own": IMAGE_KW + PROGRESS}),
         "setpoint_study": ("image", "_image", "xr.Dataset", {
             "positional": IMAGE_INPUTS + [("ratios", "Sequence[float]")], "model": False,
@@ -438,7 +445,7 @@ HEADS = {
         ":mod:`._peakforce`, :mod:`._fit`, :mod:`._image` and :mod:`._reconstruct`). Those marked\n"
         "``@_typed`` check their keywords' types first (``TypeError`` naming the keyword); the\n"
         "library checks the values (``ValueError`` naming the field and its range).",
-        "from . import _api, _fit, _fm, _image, _peakforce, _reconstruct\n"
+        "from . import _api, _fit, _fit_map, _fm, _image, _peakforce, _reconstruct\n"
         "from ._afmdyn import Params\n"
         "from ._common import Model, StateLike, _typed\n"
         "from ._progress import ProgressArg",

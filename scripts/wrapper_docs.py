@@ -342,6 +342,35 @@ Raises:
     ValueError: naming the option or the model parameter.""",
 }
 
+WRAPPERS["fit_map"] = {
+    "summary": """\
+Fit every curve of a force-volume or QI map (``afmdyn fit-map``) as :func:`fit` fits one
+(nanite's preprocessing, the probe's law, Levenberg–Marquardt, Wald intervals), the results
+over the map's grid: a modulus map, a topography and a flag per curve (fitted, at a bound,
+not constrained, too few contact rows, failed). ``probe`` (a model keyword, as ``--probe``)
+is required; a curve's own spring constant (an instrument file's) replaces the probe's.""",
+    "args": {
+        "data": "the map: an instrument file afmformats reads (JPK ``.jpk-force-map``, "
+        "``.jpk-qi-data``, …; each curve's grid index, position and spring constant from its "
+        "metadata), a list of afmformats curves or of mappings (``x``, ``y``, ``height``, "
+        "``force``, optionally ``ix``, ``iy``, ``segment``, ``time``, ``spring_constant``), "
+        "both written through :func:`afmdyn.export_map` to a temporary NetCDF file; or a "
+        "long-format CSV or an ``export_map`` NetCDF file, streamed as they are.",
+    },
+    "returns": """\
+Returns:
+    An ``xarray.Dataset`` over (``y``, ``x``) (m): per fitted parameter its value,
+    ``_standard_error``, ``_lower`` and ``_upper`` (the 95 % Wald interval), ``chi2_dof``,
+    ``contact_rows``, ``topography`` (the contact point's piezo height, m) and ``flag`` (the
+    flag's name per curve, ``no_curve`` where the grid has none); attributes ``law`` and
+    ``summary`` (the ``afmdyn fit-map --json`` document: counts per flag, the median and
+    16th–84th percentiles, every curve's estimates and reason). Warnings (curves flagged) are
+    raised as :class:`afmdyn.AfmdynWarning`.""",
+    "raises": """\
+Raises:
+    ValueError: naming the option, the map file or the probe key.""",
+}
+
 WRAPPERS["fit"] = {
     "layout_variants": {"sls": "the ``sls`` law (a curve with times)"},
     "summary": """\
@@ -520,7 +549,7 @@ Returns:
              "``LocalCluster``)."},
 }
 
-AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "image",
+AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "fit_map", "image",
        "setpoint_study", "reconstruct")
 STARTS = ("attractors", "basins", "global_continuation")
 DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM + STARTS},

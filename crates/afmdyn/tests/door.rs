@@ -227,6 +227,34 @@ fn hertz_curve(rows: usize) -> serde_json::Value {
     serde_json::json!({"height": height, "force": force})
 }
 
+/// A map of `n` × `n` quasi-static Hertz approaches of `rows` rows each (as [`hertz_curve`]'s)
+/// written as fit-map's long-format CSV (once per size, in the temporary directory): the
+/// request's keywords.
+fn hertz_map(n: usize, rows: usize) -> serde_json::Value {
+    use std::fmt::Write as _;
+    let path = std::env::temp_dir().join(format!(
+        "afmdyn-door-map-{n}-{rows}-{}.csv",
+        std::process::id()
+    ));
+    if !path.exists() {
+        let curve = hertz_curve(rows);
+        let (h, f) = (
+            curve["height"].as_array().unwrap(),
+            curve["force"].as_array().unwrap(),
+        );
+        let mut text = String::from("x,y,height,force\n");
+        for iy in 0..n {
+            for ix in 0..n {
+                for (h, f) in h.iter().zip(f) {
+                    writeln!(text, "{}e-6,{}e-6,{h},{f}", ix, iy).unwrap();
+                }
+            }
+        }
+        std::fs::write(&path, text).unwrap();
+    }
+    serde_json::json!({"data": path, "threads": 2})
+}
+
 /// A frequency-shift curve of `n` distances from 0.3 to 10 nm (Δf ∝ −d^{-3/2}), k = 40 N/m,
 /// f0 = 300 kHz, A = 1 nm.
 fn shift_curve(n: usize, inversion: &str) -> serde_json::Value {
@@ -369,6 +397,12 @@ fn case(name: &str) -> Option<Case> {
                 v["profiles"] = json!(true);
                 v
             }),
+            long_params: None,
+        },
+        "fit_map" => Case {
+            probe: Some(FIT),
+            sizes: [hertz_map(2, 1000), hertz_map(8, 2000)],
+            long: Some(hertz_map(40, 400)),
             long_params: None,
         },
         _ => return None,

@@ -28,6 +28,7 @@ from ._afmdyn import Params, SimulationError
 from ._api import cantilevers, probe
 from ._attractors import Attractor, Attractors
 from ._common import AfmdynWarning, Model, summary
+from ._fit_map import export_map
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
@@ -61,6 +62,7 @@ __all__ = [
     "Spectrum",
     "cancel_running",
     "cantilevers",
+    "export_map",
     "probe",
     "summary",
 ]

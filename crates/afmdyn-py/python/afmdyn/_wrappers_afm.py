@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Dict, Mapping, Optional, Sequence, Tuple,
 
 import xarray as xr
 
-from . import _api, _fit, _fm, _image, _peakforce, _reconstruct
+from . import _api, _fit, _fit_map, _fm, _image, _peakforce, _reconstruct
 from ._afmdyn import Params
 from ._common import Model, StateLike, _typed
 from ._progress import ProgressArg
@@ -34,6 +34,7 @@ __all__ = [
     "fm",
     "peakforce",
     "fit",
+    "fit_map",
     "image",
     "setpoint_study",
     "reconstruct",
@@ -841,6 +842,68 @@ def fit(
         ValueError: naming the option, the data or the probe key.
     """
     return _fit._finish_fit(locals())
+
+
+@_typed(si={"fit_range": "length"})
+def fit_map(
+    params: Optional[Params] = None,
+    /,
+    *,
+    data: Union[str, "os.PathLike[str]", Sequence[Any], None] = None,
+    fit: Optional[Sequence[str]] = None,
+    fit_range: Optional[Tuple[float, float]] = None,
+    segment: Optional[str] = None,
+    threads: Optional[int] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Fit every curve of a force-volume or QI map (``afmdyn fit-map``) as :func:`fit` fits one
+    (nanite's preprocessing, the probe's law, Levenberg–Marquardt, Wald intervals), the results
+    over the map's grid: a modulus map, a topography and a flag per curve (fitted, at a bound,
+    not constrained, too few contact rows, failed). ``probe`` (a model keyword, as ``--probe``)
+    is required; a curve's own spring constant (an instrument file's) replaces the probe's.
+
+    Args:
+        data: the map: an instrument file afmformats reads (JPK ``.jpk-force-map``, ``.jpk-
+            qi-data``, …; each curve's grid index, position and spring constant from its
+            metadata), a list of afmformats curves or of mappings (``x``, ``y``, ``height``,
+            ``force``, optionally ``ix``, ``iy``, ``segment``, ``time``,
+            ``spring_constant``), both written through :func:`afmdyn.export_map` to a
+            temporary NetCDF file; or a long-format CSV or an ``export_map`` NetCDF file,
+            streamed as they are.
+        fit: The parameters fitted at every curve, by their probe keys (as ``fit``'s:
+            ``sample.youngs_modulus``, ``tip.radius``, ``contact_point``, ``baseline``,
+            ``sample.hamaker`` (DMT), ``sample.adhesion_energy`` (JKR)); the others held at
+            the probe's values. Default ``sample.youngs_modulus``, ``contact_point`` and
+            ``baseline``, as nanite fits a map.
+        fit_range: The range of tip positions fitted [lo, hi] (m, relative to each curve's
+            contact point found by the deviation from the baseline, as nanite's
+            ``range_x``); default the whole segment.
+        segment: The segment fitted: ``approach`` (the default), ``retract`` or ``whole``.
+        threads: Worker threads (default: all cores); the results do not depend on it.
+        store: a directory for the command line's resumable store (``afmdyn fit_map --out
+            DIR``; created if needed, started over without ``resume``).
+        resume: continue the study stored in ``store`` from its last stored point (refused,
+            naming the first field that differs, for another request's store).
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        An ``xarray.Dataset`` over (``y``, ``x``) (m): per fitted parameter its value,
+        ``_standard_error``, ``_lower`` and ``_upper`` (the 95 % Wald interval), ``chi2_dof``,
+        ``contact_rows``, ``topography`` (the contact point's piezo height, m) and ``flag`` (the
+        flag's name per curve, ``no_curve`` where the grid has none); attributes ``law`` and
+        ``summary`` (the ``afmdyn fit-map --json`` document: counts per flag, the median and
+        16th–84th percentiles, every curve's estimates and reason). Warnings (curves flagged) are
+        raised as :class:`afmdyn.AfmdynWarning`.
+
+    Raises:
+        ValueError: naming the option, the map file or the probe key.
+    """
+    return _fit_map._finish_fit_map(locals())
 
 
 @_typed

@@ -613,8 +613,11 @@ fn netcdf_index(path: &Path) -> Result<Vec<MapCurve>, InputFileError> {
     };
     (0..curves)
         .map(|i| {
-            let count = index(n[i], "rows").ok().filter(|&c| c <= rows);
-            let count = count.ok_or_else(|| invalid(path, format!("rows = {}", n[i])))?;
+            let count = (n[i] >= 0.0 && n[i].fract() == 0.0 && n[i] <= rows as f64)
+                .then_some(n[i] as usize)
+                .ok_or_else(|| {
+                    invalid(path, format!("curve {i}: rows = {}, not 0..={rows}", n[i]))
+                })?;
             Ok(MapCurve {
                 ix: index(ix[i], "ix")?,
                 iy: index(iy[i], "iy")?,

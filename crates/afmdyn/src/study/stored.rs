@@ -455,6 +455,10 @@ where
             abort_after: None,
         };
         let output = self.request.resume(study, model, storage, progress)?;
+        // a result that is no answer (every curve, every cell failed) is the front end's error
+        if let Some(failed) = self.request.failure(&output) {
+            return Err(failed.error.into());
+        }
         Ok(named::outcome(&self.request, model, &output)?)
     }
 }
