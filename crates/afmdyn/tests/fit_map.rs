@@ -201,7 +201,7 @@ fn malformed_maps_are_refused_naming_the_file() {
     let cases = [
         (
             "no-force",
-            format!("x,y,height\n0,0,1\n"),
+            "x,y,height\n0,0,1\n".to_string(),
             "no column force",
         ),
         (
