@@ -39,6 +39,7 @@ SECTIONS = {
     "pfimage": "docs/performance/commands.md",  # scripts/perf-image-peakforce.sh
     "fit-dynamic": "docs/performance/commands.md",  # scripts/perf-fit-dynamic.sh
     "fit-coverage": "docs/performance/commands.md",  # scripts/fit-coverage.py
+    "fit-map": "docs/performance/maps.md",  # scripts/perf-fit-map.sh
     "peakforce-bias": "docs/tutorials/peakforce.md",  # scripts/peakforce-study.py
 }
 

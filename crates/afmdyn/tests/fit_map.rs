@@ -7,7 +7,6 @@
 //! resumed map identical, and malformed maps refused naming the file.
 
 use afmdyn::analysis::progress::Progress;
-use afmdyn::probe::Probe;
 use afmdyn::request::{run, FitMapRequest, Resolved};
 use afmdyn::study::fit_map::{CurveFlag, FitMap};
 use rand::{RngExt, SeedableRng};
@@ -28,12 +27,7 @@ const SIGMA: f64 = 2e-11;
 const ROWS: usize = 300;
 
 fn probe() -> Resolved {
-    let text = include_str!("../../../examples/probe-fit-hertz.toml");
-    let p = Probe::parse(text, "probe-fit-hertz.toml").expect("probe");
-    Resolved {
-        params: p.params,
-        probe: Some(p),
-    }
+    super::common::fit_hertz_probe()
 }
 
 /// The true modulus at (ix, iy): the soft inclusion a disc of radius 2 pitches about (5, 5).

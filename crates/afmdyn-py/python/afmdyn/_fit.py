@@ -90,6 +90,27 @@ _AFMFORMATS = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series",
 _MAX_INSTRUMENT_FILE = 1 << 30
 
 
+def _instrument_file(path: "os.PathLike[str] | str") -> List[Any]:
+    """The curves of the instrument file ``path``, read by afmformats (its size capped first).
+
+    Raises:
+        ValueError: naming ``data``: afmformats missing, the file unreadable or too large.
+    """
+    try:
+        import afmformats
+    except ImportError as e:
+        raise ValueError(f"data: reading {os.fspath(path)!r} needs the afmformats package "
+                         "(pip install afmformats)") from e
+    try:
+        size = os.stat(path).st_size
+    except OSError as e:
+        raise ValueError(f"data: {os.fspath(path)!r}: {e.strerror}") from e
+    if size > _MAX_INSTRUMENT_FILE:
+        raise ValueError(f"data: {os.fspath(path)!r} is {size} bytes, over the "
+                         f"{_MAX_INSTRUMENT_FILE >> 20} MiB read for one instrument file")
+    return list(afmformats.load_data(os.fspath(path)))
+
+
 def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Optional[int]]:
     """``data`` as :func:`fit` takes it, the spring constant (N/m) its file states and the rows
     of its approach: an afmformats file or object becomes the mapping of its ``height``
@@ -99,19 +120,7 @@ def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Opti
     if isinstance(data, (str, os.PathLike)):
         if not os.fspath(data).lower().endswith(_AFMFORMATS):
             return data, None, None
-        try:
-            import afmformats
-        except ImportError as e:
-            raise ValueError(f"data: reading {os.fspath(data)!r} needs the afmformats package "
-                             "(pip install afmformats)") from e
-        try:
-            size = os.stat(data).st_size
-        except OSError as e:
-            raise ValueError(f"data: {os.fspath(data)!r}: {e.strerror}") from e
-        if size > _MAX_INSTRUMENT_FILE:
-            raise ValueError(f"data: {os.fspath(data)!r} is {size} bytes, over the "
-                             f"{_MAX_INSTRUMENT_FILE >> 20} MiB read for one instrument file")
-        curves = afmformats.load_data(os.fspath(data))
+        curves = _instrument_file(data)
         if not 0 <= curve < len(curves):
             raise ValueError(f"curve: {curve} is not in 0..{len(curves) - 1} "
                              f"(the file holds {len(curves)} curve(s))")

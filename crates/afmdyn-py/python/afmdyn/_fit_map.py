@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ._common import _door, _params, _request
-from ._fit import _AFMFORMATS, _MAX_INSTRUMENT_FILE
+from ._fit import _AFMFORMATS, _instrument_file
 from ._layout import dataset
 
 #: the keywords of :func:`afmdyn.fit_map` that are not the request's as they are
@@ -63,19 +63,7 @@ def _map_file(data: Any, tmp: str) -> str:
 def _curves(data: Any) -> List[Any]:
     """The curves of ``data``: an instrument file read by afmformats, or the sequence given."""
     if isinstance(data, (str, os.PathLike)):
-        try:
-            import afmformats
-        except ImportError as e:
-            raise ValueError(f"data: reading {os.fspath(data)!r} needs the afmformats package "
-                             "(pip install afmformats)") from e
-        try:
-            size = os.stat(data).st_size
-        except OSError as e:
-            raise ValueError(f"data: {os.fspath(data)!r}: {e.strerror}") from e
-        if size > _MAX_INSTRUMENT_FILE:
-            raise ValueError(f"data: {os.fspath(data)!r} is {size} bytes, over the "
-                             f"{_MAX_INSTRUMENT_FILE >> 20} MiB read for one instrument file")
-        return list(afmformats.load_data(os.fspath(data)))
+        return _instrument_file(data)
     if isinstance(data, Mapping) or not isinstance(data, Iterable):
         raise TypeError(f"export_map(): data must be an instrument file, afmformats' curves or "
                         f"a sequence of curves (mappings with x, y, height, force), got "

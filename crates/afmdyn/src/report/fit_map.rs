@@ -34,15 +34,9 @@ pub fn unit_of(key: &str) -> &'static str {
 /// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag` and
 /// `reason`), `units`, `method` and `warnings`.
 pub fn document(m: &FitMap) -> Value {
-    let mut counts = serde_json::Map::new();
-    for (code, name) in CurveFlag::NAMES[..5].iter().enumerate() {
-        let n = m
-            .curves
-            .iter()
-            .filter(|c| c.flag.code() == code as i32)
-            .count();
-        counts.insert((*name).into(), json!(n));
-    }
+    let counts: serde_json::Map<String, Value> = (m.counts().into_iter())
+        .map(|(name, n)| (name.to_string(), json!(n)))
+        .collect();
     let usable = |c: &&CurveFit| matches!(c.flag, CurveFlag::Fitted | CurveFlag::NotConstrained);
     let mut summary = serde_json::Map::new();
     for (k, name) in m.names.iter().enumerate() {

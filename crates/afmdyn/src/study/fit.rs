@@ -6,6 +6,7 @@
 //! `super::fit_result`'s, shared with the dynamic fit, [`super::fit_dynamic`]). Everything is SI
 //! (m, N, Pa, J/m²).
 
+use crate::analysis::fit::contact_rows::ContactRows;
 use crate::analysis::fit::force_curve::{
     self, preprocess, ForceCurveModel, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
     RADIUS, YOUNGS_MODULUS,
@@ -14,6 +15,7 @@ use crate::analysis::fit::profile::ProfileWalk;
 use crate::analysis::fit::sls_curve::{
     SlsCurveModel, MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS,
 };
+use crate::analysis::fit::start::coarse_start;
 use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::contact::LawKind;
@@ -251,7 +253,7 @@ impl FitRequest {
         let names = force_curve::parameter_names(law)
             .unwrap_or_default()
             .to_vec();
-        let params = start_values(&names, s, &x, &y)?;
+        let mut params = start_values(&names, s, &x, &y)?;
         let fitted: Vec<bool> = names.iter().map(|n| fit.iter().any(|f| f == n)).collect();
         let fixed: Vec<Option<f64>> = params
             .iter()
@@ -271,30 +273,57 @@ impl FitRequest {
             }),
             _ => None,
         };
-        let elastic;
-        let m: &dyn CurveModel = match &sls {
-            Some(model) => model,
-            None => {
-                elastic = ForceCurveModel {
-                    law,
-                    x,
-                    segment,
-                    poisson_ratio: probe_value(s.poisson_ratio, "sample.poisson_ratio")?,
-                    tip: (
-                        probe_value(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-                        probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
-                    ),
-                    intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
-                };
-                &elastic
-            }
+        let elastic = match sls {
+            Some(_) => None,
+            None => Some(ForceCurveModel {
+                law,
+                x,
+                segment,
+                poisson_ratio: probe_value(s.poisson_ratio, "sample.poisson_ratio")?,
+                tip: (
+                    probe_value(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+                    probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+                ),
+                intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+            }),
+        };
+        let m: &dyn CurveModel = match (&sls, &elastic) {
+            (Some(model), _) => model,
+            (None, Some(model)) => model,
+            (None, None) => unreachable!("one of the two models is built"),
         };
         progress.check()?;
         let obs = Observations {
             y: &y,
             sigma: sig.as_deref(),
         };
-        let mut outcome = fit_cancellable(m, &obs, &params, &fixed, walk, progress)?;
+        // a long curve's elastic fit starts from the same fit on every k-th row
+        let coarse = |k: usize| -> Option<Box<dyn CurveModel>> {
+            let e = elastic.as_ref()?;
+            let x = e.x.iter().step_by(k).copied().collect();
+            Some(Box::new(ForceCurveModel { x, ..e.clone() }))
+        };
+        // Hertz's force is nil off contact: its minimum is found on the contact rows
+        let mut outcome = match elastic.as_ref().filter(|e| e.law == LawKind::Hertz) {
+            Some(e) => {
+                let over = |rows: &[usize]| -> Box<dyn CurveModel> {
+                    let x = rows.iter().map(|&i| e.x[i]).collect();
+                    Box::new(ForceCurveModel { x, ..e.clone() })
+                };
+                let at = |name| names.iter().position(|n| *n == name).unwrap_or(0);
+                let rows = ContactRows {
+                    x: &e.x,
+                    over: &over,
+                    contact_point: at(CONTACT_POINT),
+                    baseline: at(BASELINE),
+                };
+                rows.fit(m, &obs, &params, &fixed, walk, progress)?
+            }
+            None => {
+                coarse_start(&coarse, &obs, &mut params, &fixed, progress)?;
+                fit_cancellable(m, &obs, &params, &fixed, walk, progress)?
+            }
+        };
         if let Some(model) = &sls {
             outcome
                 .warnings

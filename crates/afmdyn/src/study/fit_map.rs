@@ -306,15 +306,11 @@ impl Analysis for FitMapRequest {
 impl super::named::Datasets for FitMapRequest {
     /// `fit_map` ([`FitMap::layout`]); the counts per flag as facts.
     fn datasets(&self, _: &Resolved, m: &FitMap) -> Result<super::named::Arrays, SimError> {
-        let mut facts = serde_json::Map::new();
-        for (code, name) in CurveFlag::NAMES[..5].iter().enumerate() {
-            let n = m
-                .curves
-                .iter()
-                .filter(|c| c.flag.code() == code as i32)
-                .count();
-            facts.insert(format!("curves_{name}"), json!(n));
-        }
+        let facts = m
+            .counts()
+            .into_iter()
+            .map(|(name, n)| (format!("curves_{name}"), json!(n)))
+            .collect();
         Ok((
             vec![("fit_map".into(), crate::report::fit_map::layout(m))],
             facts,

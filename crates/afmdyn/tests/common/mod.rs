@@ -458,3 +458,14 @@ impl FreeBeam {
         out
     }
 }
+
+/// The model of examples/probe-fit-hertz.toml (the force-curve fits' probe: k = 0.05 N/m,
+/// R = 5 µm, a Hertz sample of ν = 0.5).
+pub fn fit_hertz_probe() -> afmdyn::request::Resolved {
+    let text = include_str!("../../../../examples/probe-fit-hertz.toml");
+    let p = afmdyn::probe::Probe::parse(text, "probe-fit-hertz.toml").expect("probe");
+    afmdyn::request::Resolved {
+        params: p.params,
+        probe: Some(p),
+    }
+}

@@ -147,6 +147,24 @@ pub fn fit_cancellable(
         (TOLERANCE, PATIENCE),
         progress,
     )?;
+    fit_at(model, obs, params, fixed, best, profiles, progress)
+}
+
+/// [`fit_cancellable`] from its minimum `best` (found by the minimiser on `model`, or on a
+/// problem with the same minimum: `super::contact_rows`): the standard errors, intervals,
+/// correlations, warnings and the fitted curve of `model` there.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled before the fit ends.
+pub(crate) fn fit_at(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    fixed: &[Option<f64>],
+    best: super::least_squares::Minimum,
+    profiles: Option<ProfileWalk>,
+    progress: &Progress,
+) -> Result<FitOutcome, SimError> {
     let free: Vec<usize> = (0..params.len()).filter(|&j| fixed[j].is_none()).collect();
     let (m, n) = (model.points(), free.len());
     let dof = m.saturating_sub(n);

@@ -111,3 +111,17 @@ pub fn median_spread(v: &[f64]) -> Option<[f64; 3]> {
     let q = |p: f64| s[((s.len() - 1) as f64 * p).round() as usize];
     Some([q(0.5), q(0.16), q(0.84)])
 }
+
+impl FitMap {
+    /// The curves of each flag but `no_curve`, in the flags' order: (name, count).
+    pub fn counts(&self) -> Vec<(&'static str, usize)> {
+        CurveFlag::NAMES[..5]
+            .iter()
+            .enumerate()
+            .map(|(code, name)| {
+                let n = self.curves.iter().filter(|c| c.flag.code() == code as i32);
+                (*name, n.count())
+            })
+            .collect()
+    }
+}

@@ -9,6 +9,7 @@
 
 pub(crate) mod am_curve;
 pub(crate) mod bimodal_curve;
+pub(crate) mod contact_rows;
 pub(crate) mod estimates;
 pub(crate) mod fm_curve;
 pub mod force_curve;

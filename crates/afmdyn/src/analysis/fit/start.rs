@@ -94,3 +94,52 @@ mod tests {
         );
     }
 }
+
+/// The rows a curve keeps for its coarse start ([`coarse_start`]): curves longer than this are
+/// fitted first on every k-th row, k = rows / `COARSE_ROWS` rounded up.
+pub(crate) const COARSE_ROWS: usize = 1000;
+
+/// Start values from the same fit on every k-th row of a long curve (the module docs' other
+/// start): `coarse(k)` builds the model over rows 0, k, 2k, … (`None` where the model has no
+/// such subset); the minimum found there, in the bounds, starts the fit of every row, which
+/// then descends in a few evaluations instead of walking the contact point from the
+/// preprocessing's estimate over the whole curve. Curves of at most [`COARSE_ROWS`] rows, and
+/// models without a subset, keep `params`' starts.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled.
+pub(crate) fn coarse_start(
+    coarse: &dyn Fn(usize) -> Option<Box<dyn CurveModel>>,
+    obs: &Observations,
+    params: &mut [Parameter],
+    fixed: &[Option<f64>],
+    progress: &Progress,
+) -> Result<(), SimError> {
+    use super::least_squares::{minimize_cancellable, PATIENCE, TOLERANCE};
+    let k = obs.y.len().div_ceil(COARSE_ROWS);
+    let Some(model) = (k > 1).then(|| coarse(k)).flatten() else {
+        return Ok(());
+    };
+    let pick = |v: &[f64]| -> Vec<f64> { v.iter().step_by(k).copied().collect() };
+    let (y, sigma) = (pick(obs.y), obs.sigma.map(pick));
+    let sub = Observations {
+        y: &y,
+        sigma: sigma.as_deref(),
+    };
+    let start: Vec<f64> = params.iter().map(|p| p.start).collect();
+    let best = minimize_cancellable(
+        model.as_ref(),
+        &sub,
+        params,
+        &start,
+        fixed,
+        (TOLERANCE, PATIENCE),
+        progress,
+    )?;
+    for (p, v) in params.iter_mut().zip(&best.values) {
+        if v.is_finite() {
+            p.start = v.clamp(p.lower, p.upper);
+        }
+    }
+    Ok(())
+}

@@ -79,17 +79,8 @@ pub(crate) fn fit_map(m: &FitMap, document: &Value) -> Presentation {
         }),
     );
     s.figure("curves", curves(m));
-    let counts: Vec<String> = CurveFlag::NAMES[..5]
-        .iter()
-        .enumerate()
-        .map(|(code, name)| {
-            let n = m
-                .curves
-                .iter()
-                .filter(|c| c.flag.code() == code as i32)
-                .count();
-            format!("{n} {}", name.replace('_', " "))
-        })
+    let counts: Vec<String> = (m.counts().into_iter())
+        .map(|(name, n)| format!("{n} {}", name.replace('_', " ")))
         .collect();
     s.summary.insert(
         0,
