@@ -51,50 +51,6 @@ pub(crate) fn grid_start(
     Ok(best.1)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// f = (x − p)² at x = 0 … 4: χ² of y = 0 has its least at p = x's mean, 2.
-    struct Bowl;
-    impl CurveModel for Bowl {
-        fn points(&self) -> usize {
-            5
-        }
-        fn evaluate(&self, p: &[f64], v: &mut [f64], _: Option<&mut [f64]>) {
-            for (i, vi) in v.iter_mut().enumerate() {
-                *vi = i as f64 - p[0];
-            }
-        }
-    }
-
-    #[test]
-    fn the_grid_start_is_the_least_chi2_of_the_grid() {
-        let params = [Parameter {
-            name: "p".into(),
-            start: -7.0,
-            lower: f64::NEG_INFINITY,
-            upper: f64::INFINITY,
-            scale: 1.0,
-        }];
-        let y = [0.0; 5];
-        let obs = Observations { y: &y, sigma: None };
-        let p = Progress::default();
-        let grid = (0..9).map(|i| 0.5 * i as f64);
-        assert_eq!(grid_start(&Bowl, &obs, &params, 0, grid, &p).unwrap(), 2.0);
-        assert_eq!(
-            grid_start(&Bowl, &obs, &params, 0, [f64::NAN], &p).unwrap(),
-            -7.0
-        );
-        let g: Vec<f64> = z_offset_grid(2.0).collect();
-        assert_eq!(g.len(), 13);
-        assert_eq!(
-            (g[0], g[6], g[12]),
-            (-0.6000000000000001, 0.0, 0.6000000000000001)
-        );
-    }
-}
-
 /// The rows a curve keeps for its coarse start ([`coarse_start`]): curves longer than this are
 /// fitted first on every k-th row, k = rows / `COARSE_ROWS` rounded up.
 pub(crate) const COARSE_ROWS: usize = 1000;
@@ -142,4 +98,48 @@ pub(crate) fn coarse_start(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f = (x − p)² at x = 0 … 4: χ² of y = 0 has its least at p = x's mean, 2.
+    struct Bowl;
+    impl CurveModel for Bowl {
+        fn points(&self) -> usize {
+            5
+        }
+        fn evaluate(&self, p: &[f64], v: &mut [f64], _: Option<&mut [f64]>) {
+            for (i, vi) in v.iter_mut().enumerate() {
+                *vi = i as f64 - p[0];
+            }
+        }
+    }
+
+    #[test]
+    fn the_grid_start_is_the_least_chi2_of_the_grid() {
+        let params = [Parameter {
+            name: "p".into(),
+            start: -7.0,
+            lower: f64::NEG_INFINITY,
+            upper: f64::INFINITY,
+            scale: 1.0,
+        }];
+        let y = [0.0; 5];
+        let obs = Observations { y: &y, sigma: None };
+        let p = Progress::default();
+        let grid = (0..9).map(|i| 0.5 * i as f64);
+        assert_eq!(grid_start(&Bowl, &obs, &params, 0, grid, &p).unwrap(), 2.0);
+        assert_eq!(
+            grid_start(&Bowl, &obs, &params, 0, [f64::NAN], &p).unwrap(),
+            -7.0
+        );
+        let g: Vec<f64> = z_offset_grid(2.0).collect();
+        assert_eq!(g.len(), 13);
+        assert_eq!(
+            (g[0], g[6], g[12]),
+            (-0.6000000000000001, 0.0, 0.6000000000000001)
+        );
+    }
 }
