@@ -32,7 +32,8 @@ pub fn unit_of(key: &str) -> &'static str {
 /// per parameter its `median` and 16th–84th percentiles over the curves fitted (`summary`),
 /// `curves` (each curve's `x`, `y`, `ix`, `iy`, `estimates` keyed as `fit`'s with `value`,
 /// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag` and
-/// `reason`), `units`, `method` and `warnings`.
+/// `reason`), `units`, `preprocessing` (nanite's steps, how the contact point is found, the
+/// segment and `range_x`), `method` and `warnings`.
 pub fn document(m: &FitMap) -> Value {
     let counts: serde_json::Map<String, Value> = (m.counts().into_iter())
         .map(|(name, n)| (name.to_string(), json!(n)))
@@ -69,6 +70,18 @@ pub fn document(m: &FitMap) -> Value {
         "summary": summary,
         "curves": curves,
         "units": units,
+        "preprocessing": {
+            // nanite's steps and names (Müller et al. 2019; nanite 4.2 preproc.py, poc.py)
+            "steps": ["compute_tip_position", "correct_force_offset", "correct_tip_offset"],
+            "contact_point": if m.names.iter().any(|n| n == CONTACT_POINT) {
+                "fitted, from deviation_from_baseline's estimate"
+            } else {
+                "deviation_from_baseline (held)"
+            },
+            "segment": m.segment,
+            "range_x": m.range,
+            "range_type": "relative to deviation_from_baseline's contact point (tip positions after correct_tip_offset)",
+        },
         "method": "every curve fitted as fit fits one (nanite's preprocessing; Levenberg–Marquardt; \
                    no σ: the noise estimated from the residuals), its intervals Wald's (±1.96 \
                    standard errors); a curve at a bound of a parameter's physical range, not \

@@ -11,7 +11,7 @@ use super::fit::Curve;
 #[cfg(feature = "files")]
 use super::task_store::{Encoding, Lines, TaskFiles, TaskStore};
 use super::Tasks;
-use crate::analysis::fit::force_curve::{BASELINE, CONTACT_POINT};
+use crate::analysis::fit::force_curve::{Segment, BASELINE, CONTACT_POINT};
 use crate::analysis::fit::map::SHOWN_POINTS;
 pub use crate::analysis::fit::map::{CurveFit, CurveFlag, FitMap, ShownCurve};
 use crate::analysis::progress::Progress;
@@ -199,6 +199,12 @@ impl MapStudy {
             ys: self.map.ys.clone(),
             names: self.names.clone(),
             curves: lines.into_iter().flatten().collect(),
+            segment: match self.request.segment_of(self.law) {
+                Segment::Approach => "approach",
+                Segment::Retract => "retract",
+                Segment::Whole => "whole",
+            },
+            range: self.request.range,
         })
     }
 }

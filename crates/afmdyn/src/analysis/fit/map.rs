@@ -99,6 +99,11 @@ pub struct FitMap {
     pub names: Vec<String>,
     /// Every curve's fit, ordered by line then column.
     pub curves: Vec<CurveFit>,
+    /// The segment fitted (`approach`, `retract` or `whole`).
+    pub segment: &'static str,
+    /// The range of tip positions fitted (m, relative to each curve's contact point by the
+    /// deviation from the baseline), `None`: the whole segment.
+    pub range: Option<[f64; 2]>,
 }
 
 /// The median and the 16th and 84th percentiles of `v` (finite values; `None` when empty).
