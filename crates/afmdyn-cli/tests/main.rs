@@ -11,6 +11,7 @@ mod bimodal;
 mod bounded_inputs;
 mod chart;
 mod cli;
+mod fit_map;
 mod fm;
 mod image;
 mod interrupt;
