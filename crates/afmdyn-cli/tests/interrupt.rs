@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 
 /// How a request kind is run from the command line.
 enum Case {
-    /// `afmdyn ARGS` runs it for seconds; `out`: the subcommand takes `--out`. `{fit}` and
-    /// `{fm}` stand for the data files [`data_files`] writes.
+    /// `afmdyn ARGS` runs it for seconds; `out`: the subcommand takes `--out`. `{fit}`, `{fm}`
+    /// and `{map}` stand for the data files [`data_files`] writes.
     Long {
         args: &'static [&'static str],
         out: bool,
@@ -168,6 +168,16 @@ fn case(name: &str) -> Option<Case> {
             ],
             out: true,
         },
+        "fit_map" => Long {
+            args: &[
+                "fit-map",
+                "--probe",
+                "examples/probe-fit-hertz.toml",
+                "--data",
+                "{map}",
+            ],
+            out: true,
+        },
         _ => return None,
     })
 }
@@ -220,6 +230,16 @@ fn data_files(dir: &Path) {
     }
     std::fs::write(dir.join("fit.csv"), fit).unwrap();
     std::fs::write(dir.join("fm.csv"), fm).unwrap();
+    // a force map of 50 × 50 such curves of 600 rows (a second of fitting)
+    let mut map = String::from("x,y,height,force\n");
+    for c in 0..2500 {
+        for i in 0..600 {
+            let x = 1e-6 - 2.5e-6 * i as f64 / 599.0;
+            let f = 4.0 / 3.0 * e_star * f64::sqrt(r) * (-x).max(0.0).powf(1.5);
+            writeln!(map, "{}e-6,{}e-6,{:e},{:e}", c % 50, c / 50, x - f / k, f).unwrap();
+        }
+    }
+    std::fs::write(dir.join("map.csv"), map).unwrap();
 }
 
 /// `afmdyn` with SIGINT at its default action in the child, whatever this process inherited
@@ -297,6 +317,7 @@ fn ctrl_c_ends_every_request_kind_within_a_second() {
     let dir = tempfile::tempdir().unwrap();
     data_files(dir.path());
     let (fit, fm) = (dir.path().join("fit.csv"), dir.path().join("fm.csv"));
+    let map = dir.path().join("map.csv");
     let mut wrong = Vec::new();
     for name in afmdyn::request::named::NAMES {
         let Some(Case::Long { args, out }) = case(name) else {
@@ -307,6 +328,7 @@ fn ctrl_c_ends_every_request_kind_within_a_second() {
             .map(|a| match *a {
                 "{fit}" => fit.display().to_string(),
                 "{fm}" => fm.display().to_string(),
+                "{map}" => map.display().to_string(),
                 a => a.to_string(),
             })
             .collect();
