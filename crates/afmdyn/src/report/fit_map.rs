@@ -29,7 +29,8 @@ pub fn unit_of(key: &str) -> &'static str {
 
 /// The document of a fitted map (`afmdyn fit-map --json`, Python's `summary`): `law`,
 /// `grid` (x and y positions, m), `fitted` (the probe keys), `counts` (curves per flag),
-/// per parameter its `median` and 16th–84th percentiles over the curves fitted (`summary`),
+/// per parameter its `median` and 16th–84th percentiles over the curves flagged `fitted`
+/// (`summary`),
 /// `curves` (each curve's `x`, `y`, `ix`, `iy`, `estimates` keyed as `fit`'s with `value`,
 /// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag` and
 /// `reason`), `units`, `preprocessing` (nanite's steps, how the contact point is found, the
@@ -38,7 +39,7 @@ pub fn document(m: &FitMap) -> Value {
     let counts: serde_json::Map<String, Value> = (m.counts().into_iter())
         .map(|(name, n)| (name.to_string(), json!(n)))
         .collect();
-    let usable = |c: &&CurveFit| matches!(c.flag, CurveFlag::Fitted | CurveFlag::NotConstrained);
+    let usable = |c: &&CurveFit| c.flag == CurveFlag::Fitted;
     let mut summary = serde_json::Map::new();
     for (k, name) in m.names.iter().enumerate() {
         let v: Vec<f64> = m

@@ -152,7 +152,7 @@ impl MapStudy {
         let contact_rows = x.iter().filter(|&&x| x < cp).count();
         let contact_height = cp + r.curve.tip_offset - (r.curve.force_offset + value(BASELINE)) / k;
         let finite = |v: f64| v.is_finite().then_some(v);
-        let (flag, reason) = flag_of(&r, contact_rows);
+        let (flag, reason) = flag_of(&r, contact_rows, value(BASELINE));
         let shown = show.then(|| {
             let step = x.len().div_ceil(SHOWN_POINTS).max(1);
             let pick = |v: &[f64]| v.iter().step_by(step).copied().collect();
@@ -244,16 +244,48 @@ fn failed(c: &MapCurve, n: usize, reason: String) -> CurveFit {
     }
 }
 
-/// The flag of the fit `r` with `contact_rows` rows indented, and its reason: the first of
-/// too few contact rows, an estimate at a bound of its physical range
-/// ([`super::fit_result::bounds`]), an estimate not constrained (no finite standard error;
-/// for a probe key, a standard error as large as the value).
-fn flag_of(r: &super::fit_result::FitResult, contact_rows: usize) -> (CurveFlag, Option<String>) {
+/// The flag of the fit `r` with `contact_rows` rows indented and the fitted `baseline` (N),
+/// and its reason: the first of too few contact rows; no contact (the fitted contact force
+/// never rises 3 σ above the baseline, σ the noise the residuals give: a curve on the
+/// substrate beside a cell, or one that stops short of the sample, whose E the fit drives to
+/// anything); a minimiser that did not converge (`failed`, its values kept); an estimate at a bound of its physical range ([`super::fit_result::bounds`]);
+/// an estimate not constrained (no finite standard error; for a probe key, a standard error as
+/// large as the value).
+fn flag_of(
+    r: &super::fit_result::FitResult,
+    contact_rows: usize,
+    baseline: f64,
+) -> (CurveFlag, Option<String>) {
     if contact_rows < MIN_FIT_ROWS {
         return (
             CurveFlag::TooFewContactRows,
             Some(format!(
                 "{contact_rows} rows indented beyond the contact point (at least {MIN_FIT_ROWS})"
+            )),
+        );
+    }
+    let o = &r.outcome;
+    let peak = o.fitted.iter().fold(0.0_f64, |m, f| m.max(f - baseline));
+    let noise = if o.noise_estimated {
+        o.chi2_dof.sqrt()
+    } else {
+        0.0
+    };
+    if !(peak > 3.0 * noise) {
+        return (
+            CurveFlag::NotConstrained,
+            Some(format!(
+                "no contact: the fitted contact force peaks at {peak:.3e} N, within 3 σ of the \
+                 noise (σ = {noise:.3e} N)"
+            )),
+        );
+    }
+    if !o.converged {
+        return (
+            CurveFlag::Failed,
+            Some(format!(
+                "the minimiser did not converge ({})",
+                o.termination
             )),
         );
     }
@@ -286,7 +318,8 @@ fn flag_of(r: &super::fit_result::FitResult, contact_rows: usize) -> (CurveFlag,
 impl Analysis for FitMapRequest {
     type Output = FitMap;
     fn convergence(&self, m: &FitMap) -> Convergence {
-        Convergence::count("curves", &m.curves, |c| c.flag == CurveFlag::Fitted)
+        // a curve converged when its fit did (its flag says what the fit determines)
+        Convergence::count("curves", &m.curves, |c| c.flag != CurveFlag::Failed)
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitMap, SimError> {
         let study = MapStudy::new(self, model)?;

@@ -17,12 +17,13 @@ pub enum CurveFlag {
     Fitted,
     /// An estimate at a bound of its physical range (the probe key's, e.g. E ≥ 1 Pa).
     AtBound,
-    /// An estimate the data do not constrain (no finite standard error, or one as large as
-    /// the value).
+    /// No contact above the noise, or an estimate the data do not constrain (no finite
+    /// standard error, or one as large as the value).
     NotConstrained,
     /// Fewer than 8 rows (the fit's fewest) indented beyond the fitted contact point.
     TooFewContactRows,
-    /// No fit (too few rows in the segment or range, a curve that could not be read).
+    /// No fit (too few rows in the segment or range, a curve that could not be read), or a
+    /// minimiser that did not converge (its values kept).
     Failed,
 }
 

@@ -14,9 +14,10 @@ fn mapped(m: &FitMap) -> Option<usize> {
     m.names.iter().position(|n| n.contains('.'))
 }
 
-/// Whether a curve's value goes into the maps and histogram (fitted, or not constrained).
+/// Whether a curve's value goes into the maps and histogram: flagged `fitted` (the others are
+/// in the dataset with their flags).
 fn shown(c: &CurveFit) -> bool {
-    matches!(c.flag, CurveFlag::Fitted | CurveFlag::NotConstrained)
+    c.flag == CurveFlag::Fitted
 }
 
 /// The presentation of `m`, its `document` written as `fit_map.json`.
