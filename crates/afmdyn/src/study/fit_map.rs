@@ -271,7 +271,8 @@ fn flag_of(
     } else {
         0.0
     };
-    if !(peak > 3.0 * noise) {
+    // (a NaN peak or noise is no contact either)
+    if peak.partial_cmp(&(3.0 * noise)) != Some(std::cmp::Ordering::Greater) {
         return (
             CurveFlag::NotConstrained,
             Some(format!(
