@@ -433,7 +433,6 @@ fn csv_index(path: &Path) -> Result<(CsvColumns, Vec<MapCurve>), InputFileError>
     Ok((columns, curves))
 }
 
-#[cfg(feature = "files")]
 /// Row `.0` of the curve `.1`, as a refusal names it.
 #[cfg(feature = "files")]
 struct Row<'a>(u64, &'a MapCurve);
@@ -450,6 +449,7 @@ impl std::fmt::Display for Row<'_> {
 }
 
 /// The rows of `curve` from where the CSV `file` stands (its first row).
+#[cfg(feature = "files")]
 fn csv_rows(
     path: &Path,
     file: &mut std::fs::File,

@@ -1,10 +1,10 @@
 //! `fit-map`'s running ([`crate::request::fit_map`] is the request): every curve of a map
-//! fitted as `fit` fits one ([`FitRequest::fit_curve`], its intervals Wald's), as a study of
+//! fitted as `fit` fits one (`FitRequest::fit_curve`, its intervals Wald's), as a study of
 //! independent tasks — one task a line of the map, its curves read from the file one at a time
 //! ([`crate::io::force_map`]), so memory holds the map's index, its records and one curve per
 //! worker. Each curve's record ([`CurveFit`]) carries its estimates and a flag
 //! ([`CurveFlag`]): a result at a bound of its physical range, or not constrained by the data,
-//! is flagged, never clamped silently. The store ([`fit_map_store`]) resumes an interrupted map
+//! is flagged, never clamped silently. The store (`fit_map_store`) resumes an interrupted map
 //! of the same request, map file and probe.
 
 use super::fit::Curve;
@@ -344,7 +344,7 @@ impl Analysis for FitMapRequest {
 }
 
 impl super::named::Datasets for FitMapRequest {
-    /// `fit_map` ([`FitMap::layout`]); the counts per flag as facts.
+    /// `fit_map` ([`crate::report::fit_map::layout`]); the counts per flag as facts.
     fn datasets(&self, _: &Resolved, m: &FitMap) -> Result<super::named::Arrays, SimError> {
         let facts = m
             .counts()

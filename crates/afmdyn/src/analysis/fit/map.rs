@@ -45,7 +45,7 @@ impl CurveFlag {
 }
 
 /// A curve drawn in the figure of curves: its fitted rows' tip positions (m), forces and fit
-/// (N), at most [`SHOWN_POINTS`] of them.
+/// (N), at most 400 of them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ShownCurve {
     /// Tip positions (m).
