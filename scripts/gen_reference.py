@@ -583,7 +583,8 @@ def layout_pages() -> Dict[str, str]:
              "`xarray.Dataset`s of the Python functions and the Zarr stores of `afmdyn.dask` "
              "are written from these layouts. For each dataset: its variables with their dims, "
              "unit, kind (`float`, `int`, `bool`, `text`, `complex`) and meaning, and the "
-             "meanings of a code's values. Without a probe the quantities are in the model's "
+             "meanings of a code's values (an image's `material` and `domain` name the "
+             "materials and domains of the sample file: those of the example here). Without a probe the quantities are in the model's "
              "units (g0, F̃, τ, Ω); under a probe they are in SI.", "",
              "```{toctree}", ":hidden:", "", *[p for p, *_ in groups], "```", "",
              "| Analysis | Datasets | Variants |", "|---|---|---|"]
