@@ -20,6 +20,11 @@ front ends already declare, so that no reference table is written by hand (issue
   module that lists it.
 * ``messages.md``: the errors of the library's door (``SimError`` in
   ``crates/afmdyn/src/error.rs``): each variant's message and its doc comment.
+* ``layouts.md`` and ``layouts/{dynamics,curves,images}.md``: the variables of every analysis's result
+  (their dims, unit, kind, meaning and the meanings of a code's values), from
+  ``docs/schema/layouts/*.json`` (written and checked by ``crates/afmdyn/tests/layouts.rs`` from
+  the library's result layouts, which the NetCDF files, the Python Datasets and the Dask stores
+  are written from).
 * ``index.md``: the toctree of these pages.
 
     python3 scripts/gen_reference.py                  # rewrite the pages
@@ -413,6 +418,192 @@ def messages_page() -> str:
     return "\n".join(out) + "\n"
 
 
+# --- layouts.md and layouts/*.md -------------------------------------------------------------
+
+LAYOUTS = ROOT / "docs" / "schema" / "layouts"
+
+#: the pages of the layouts: their file under ``docs/reference``, title, sentence and analyses
+#: (an analysis no group names goes to the last group)
+LAYOUT_GROUPS = [
+    ("layouts/dynamics", "Layouts of the dynamics' results",
+     "The analyses of the paper's model: trajectories, modes, steady states, bifurcations, "
+     "orbits, continuation, Lyapunov exponents, behaviour charts and random starts.",
+     ["simulate", "modes", "converge", "bifurcation", "orbit", "continuation", "lyapunov",
+      "chart", "attractors", "basins", "global_continuation"]),
+    ("layouts/curves", "Layouts of the AFM curves",
+     "The AFM measurements over a distance or a frequency: the observables of a steady state, "
+     "approach and resonance curves, FM-AFM and bimodal curves.",
+     ["observe", "approach", "resonance", "fm", "bimodal"]),
+    ("layouts/images", "Layouts of PeakForce, fits and images",
+     "PeakForce cycles and sweeps, fits of measured curves, images (ideal feedback, PI scan, "
+     "PeakForce), the force reconstruction and the setpoint study.",
+     ["peakforce", "fit", "image", "reconstruct", "setpoint_study"]),
+]
+
+
+def layouts() -> Dict[str, List[Tuple[Optional[str], dict]]]:
+    """The layout files of each analysis: (variant, layout), the one without a variant first."""
+    out: Dict[str, List[Tuple[Optional[str], dict]]] = {}
+    for path in sorted(LAYOUTS.glob("*.json")):
+        data = json.loads(path.read_text())
+        out.setdefault(data["analysis"], []).append((data.get("variant"), data))
+    for files in out.values():
+        files.sort(key=lambda f: (f[0] is not None, f[0] or ""))
+    return out
+
+
+def layout_groups() -> List[Tuple[str, str, str, List[str]]]:
+    names = list(layouts())
+    known = {a for *_, analyses in LAYOUT_GROUPS for a in analyses}
+    groups = [(p, t, w, [a for a in analyses if a in names]) for p, t, w, analyses in
+              LAYOUT_GROUPS]
+    groups[-1][3].extend(a for a in names if a not in known)
+    return groups
+
+
+def code(names: List[str]) -> str:
+    return ", ".join(f"`{n}`" for n in names)
+
+
+def meaning(v: dict) -> str:
+    """A variable's long name, with the meanings of its flags and its other attributes."""
+    attrs = dict((k, x) for k, x in v["attrs"])
+    text = v["long_name"]
+    if "flag_values" in attrs and "flag_meanings" in attrs:
+        pairs = zip(attrs.pop("flag_values"), str(attrs.pop("flag_meanings")).split())
+        text += ". Flags: " + ", ".join(f"{n} `{m}`" for n, m in pairs)
+    for k, x in attrs.items():
+        text += f". {k.replace('_', ' ').capitalize()}: {x}"
+    return text
+
+
+def unit(u: str) -> str:
+    return cell(u) if u else "–"
+
+
+def example(data: dict) -> str:
+    """The example request a layout file was written from."""
+    ex = data["example"]
+    probe = (f"with the probe `{ex['probe']}`" if ex.get("probe")
+             else "without a probe (the model's units)")
+    request = json.dumps(ex["request"], separators=(", ", ": "))
+    return f"Laid out for the request `{request}` {probe}."
+
+
+def dataset_head(analysis: str, ds: dict, many: bool, level: str = "###",
+                 label: str = "") -> List[str]:
+    title = f"*{cell(ds['title'])}*" if ds.get("title") else ""
+    lines = [f"Dataset `{ds['name']}` over {code(ds['dims'])}" + (f": {title}" if title else "")
+             + ".", ""]
+    if many or label:
+        lines = [f"{level} {analysis}{label}: `{ds['name']}`", ""] + lines
+    return lines
+
+
+def variable_rows(variables: List[dict], si: Optional[Dict[str, dict]]) -> List[str]:
+    """The table of ``variables``; with ``si`` (variable name → its counterpart under a probe),
+    a column of the unit (and name, where it differs) under a probe."""
+    if si is None:
+        out = ["| Variable | Dims | Unit | Kind | Meaning |", "|---|---|---|---|---|"]
+    else:
+        out = ["| Variable | Dims | Unit | With a probe | Kind | Meaning |",
+               "|---|---|---|---|---|---|"]
+    for v in variables:
+        row = [f"`{v['name']}`", code(v["dims"]) or "(scalar)", unit(v["units"])]
+        if si is not None:
+            s = si.get(v["name"])
+            row.append("" if s is None else unit(s["units"]) if s["name"] == v["name"]
+                       else f"`{s['name']}` ({unit(s['units'])})")
+        row += [v["kind"], cell(meaning(v))]
+        out.append("| " + " | ".join(row) + " |")
+    return out
+
+
+def analysis_section(analysis: str, files: List[Tuple[Optional[str], dict]]) -> List[str]:
+    base = files[0][1]
+    si_file = next((d for var, d in files if var == "si"), None)
+    python = f"`afmdyn.{analysis}`"
+    out = [f"## {analysis}", "", f"The result of {python}. {example(base)}"]
+    if si_file is not None:
+        renamed = [(a, b) for da, db in zip(base["datasets"], si_file["datasets"])
+                   for a, b in zip(da["dims"], db["dims"]) if a != b]
+        out[-1] += (" Under a probe (" + example(si_file)[len("Laid out for "):-1]
+                    + ") the same variables are in SI: the column *With a probe* gives their "
+                    "unit there")
+        out[-1] += ("" if not renamed else ", and the dims " + ", ".join(
+            f"`{a}` become `{b}`" for a, b in renamed)) + "."
+    out.append("")
+    many = len(base["datasets"]) > 1
+    for k, ds in enumerate(base["datasets"]):
+        si = None
+        if si_file is not None:
+            sds = si_file["datasets"][k]
+            si = {a["name"]: b for a, b in zip(ds["variables"], sds["variables"])}
+        out += dataset_head(analysis, ds, many)
+        out += variable_rows(ds["variables"], si) + [""]
+    for variant, data in files[1:]:
+        if variant == "si":
+            continue
+        out += [f"### {analysis}: variant `{variant}`", "", example(data), ""]
+        known = {ds["name"]: ds for ds in base["datasets"]}
+        for ds in data["datasets"]:
+            old = known.get(ds["name"])
+            if old is None:
+                out += dataset_head(analysis, ds, False, "####", f" `{variant}`")
+                out += variable_rows(ds["variables"], None) + [""]
+                continue
+            before = {v["name"]: v for v in old["variables"]}
+            names = {v["name"] for v in ds["variables"]}
+            changed = [v for v in ds["variables"] if before.get(v["name"]) != v]
+            gone = [n for n in before if n not in names]
+            words = f"Dataset `{ds['name']}`"
+            if ds["dims"] != old["dims"]:
+                words += f" over {code(ds['dims'])}"
+            if ds.get("title") != old.get("title"):
+                words += f": *{cell(ds['title'])}*"
+            if not changed and not gone:
+                out += [words + ": the same variables.", ""]
+                continue
+            words += (". Its variables that are new or differ"
+                      + (f" (it has no {code(gone)})" if gone else "") + ":")
+            out += [words, ""]
+            out += (variable_rows(changed, None) if changed else ["(none)"]) + [""]
+    return out
+
+
+def layout_pages() -> Dict[str, str]:
+    """``layouts.md`` (the analyses and their pages) and one page per group of analyses."""
+    files = layouts()
+    source = header("docs/schema/layouts/*.json (written by crates/afmdyn/tests/layouts.rs "
+                    "from the library's result layouts)")
+    groups = layout_groups()
+    index = [source, "# Result layouts", "",
+             "The arrays of every analysis's result, as the library lays them out "
+             "(`afmdyn::layout::Layout`): the NetCDF files of the command line, the "
+             "`xarray.Dataset`s of the Python functions and the Zarr stores of `afmdyn.dask` "
+             "are written from these layouts. For each dataset: its variables with their dims, "
+             "unit, kind (`float`, `int`, `bool`, `text`, `complex`) and meaning, and the "
+             "meanings of a code's values (an image's `material` and `domain` name the "
+             "materials and domains of the sample file: those of the example here). Without a probe the quantities are in the model's "
+             "units (g0, F̃, τ, Ω); under a probe they are in SI.", "",
+             "```{toctree}", ":hidden:", "", *[p for p, *_ in groups], "```", "",
+             "| Analysis | Datasets | Variants |", "|---|---|---|"]
+    pages: Dict[str, str] = {}
+    for page, title, words, analyses in groups:
+        out = [source, f"# {title}", "", words + " Each section names the Python function "
+               "whose Dataset it is and the small request its layout was written for; a "
+               "layout's sizes follow the request.", ""]
+        for a in analyses:
+            out += analysis_section(a, files[a])
+            variants = [v for v, _ in files[a] if v]
+            index.append(f"| [`{a}`]({page}.md#{a}) | "
+                         f"{code([ds['name'] for ds in files[a][0][1]['datasets']])} | "
+                         f"{code(variants)} |")
+        pages[f"{page}.md"] = "\n".join(out).rstrip("\n") + "\n"
+    pages["layouts.md"] = "\n".join(index) + "\n"
+    return pages
+
+
 # --- index.md and main ---------------------------------------------------------------------
 
 #: the pages of the reference, in the toctree's order
@@ -421,6 +612,7 @@ PAGES: Dict[str, Callable[[], str]] = {
     "probe-keys": probe_keys_page,
     "python": python_page,
     "messages": messages_page,
+    "layouts": lambda: "",
 }
 
 
@@ -443,8 +635,10 @@ def visible(page: str) -> str:
 
 def generate() -> Dict[Path, str]:
     """The text of every generated page."""
-    out = {REF / f"{name}.md": make() for name, make in PAGES.items() if name != "commands"}
+    out = {REF / f"{name}.md": make() for name, make in PAGES.items()
+           if name not in ("commands", "layouts")}
     out.update({REF / p: t for p, t in commands_pages(HELP.read_text()).items()})
+    out.update({REF / p: t for p, t in layout_pages().items()})
     out[REF / "index.md"] = index_page()
     return {p: visible(t) for p, t in out.items()}
 
