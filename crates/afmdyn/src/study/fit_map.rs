@@ -103,8 +103,22 @@ impl MapStudy {
         .weighted(move |t| self.map.lines[t].len() as u64)
     }
 
+    /// The number of the map's lines (its tasks).
+    pub(crate) fn lines(&self) -> usize {
+        self.map.lines.len()
+    }
+
+    /// What a resumed run must match (the store's fingerprint).
+    pub(crate) fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
     /// The fits of line `t`'s curves; `None` when cancelled before its end.
-    fn line(&self, t: usize, cancel: &AtomicBool) -> Result<Option<Vec<CurveFit>>, SimError> {
+    pub(crate) fn line(
+        &self,
+        t: usize,
+        cancel: &AtomicBool,
+    ) -> Result<Option<Vec<CurveFit>>, SimError> {
         let range = self.map.lines[t].clone();
         let mut reader = match self.map.reader() {
             Ok(r) => r,
