@@ -96,8 +96,7 @@ impl MapStudy {
 
     /// The study's tasks: the map's lines, each counting its curves.
     pub(crate) fn tasks(&self) -> Tasks<'_, Vec<CurveFit>> {
-        let lines = self.map.lines.len();
-        Tasks::new(&self.fingerprint, lines, move |t, cancel| {
+        Tasks::new(&self.fingerprint, self.lines(), move |t, cancel| {
             self.line(t, cancel)
         })
         .weighted(move |t| self.map.lines[t].len() as u64)
@@ -109,6 +108,7 @@ impl MapStudy {
     }
 
     /// What a resumed run must match (the store's fingerprint).
+    #[cfg(feature = "files")]
     pub(crate) fn fingerprint(&self) -> &Value {
         &self.fingerprint
     }
