@@ -131,6 +131,13 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "image": ("image", "_dask", "xr.Dataset", {
             **IMAGE, "first": CLIENT + PROGRESS, "typed": False,
             "own": [k for k in IMAGE_KW if k[0] not in ("feedback", "threads")]}),
+        "fit_map": ("fit_map", "_dask", "xr.Dataset", {
+            "first": DASK_KW, "omit": ("threads",), "typed": False,
+            "rename": {"range": "fit_range"},
+            "override": {
+                "data": ('Union[str, "os.PathLike[str]", Sequence[Any], None]', "None"),
+                "fit": ("Optional[Sequence[str]]", "None"),
+                "range": ("Optional[Tuple[float, float]]", "None")}}),
     },
 }
 

@@ -549,6 +549,36 @@ Returns:
              "``LocalCluster``)."},
 }
 
+DASK["fit_map"] = {
+    "summary": """\
+:func:`afmdyn.fit_map` (the same keywords but ``threads``) with the lines of the map
+mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this machine's
+cores, closed at the end): each line is a task, its curves read by the worker from the map
+file and fitted as :func:`afmdyn.fit_map` fits them. The map file (``data``, or the NetCDF
+file curves given as data are exported to: into ``store``, else a temporary directory of
+this machine) must be readable by every worker at the same path: a ``LocalCluster`` shares
+this machine's files; a cluster of several machines needs the map (and ``store``) on a
+shared filesystem, named by an absolute path.
+
+With ``store`` (a directory, locked during the run) the fits are kept in the command
+line's layout (``afmdyn fit-map --out DIR``, ``afmdyn.fit_map(store=...)``): each finished
+line is appended as it arrives, and a rerun with the same request resumes — from a run of
+this function, of :func:`afmdyn.fit_map` or of the command line — fitting only the lines
+not stored (``resume=False`` starts over; another request or map is refused).""",
+    "returns": """\
+Returns:
+    The same ``xarray.Dataset`` as :func:`afmdyn.fit_map` with the same arguments, bit for
+    bit (a line's fits are a pure function of the request and the map). Warnings (curves
+    flagged) are raised as :class:`afmdyn.AfmdynWarning`.""",
+    "raises": WRAPPERS["fit_map"].get("raises", ""),
+    "args": {
+        "client": "a ``dask.distributed.Client`` (default: a ``LocalCluster``).",
+        "store": "a directory keeping the fits in the command line's layout.",
+        "resume": "resume the stored map (``False``: start it over).",
+        **WRAPPERS["fit_map"]["args"],
+    },
+}
+
 AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "fit_map", "image",
        "setpoint_study", "reconstruct")
 STARTS = ("attractors", "basins", "global_continuation")

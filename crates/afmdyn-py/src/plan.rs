@@ -1,6 +1,6 @@
 //! The tasks `afmdyn.dask` maps over a cluster: [`Plan`], a study the library plans as stages
 //! of numbered tasks ([`afmdyn::study::plan`]: a bifurcation sweep, a basin map, a PI-scanned
-//! or PeakForce image), which any process rebuilds from its recipe (JSON text), so that it
+//! or PeakForce image, a fitted force map), which any process rebuilds from its recipe (JSON text), so that it
 //! pickles to Dask workers as a few hundred bytes. Starts and results travel as text; the ledger (which tasks
 //! a store holds, how results merge) is the library's ([`PlanStore`]).
 
@@ -29,10 +29,11 @@ impl Plan {
         Ok(Plan { plan })
     }
 
-    /// The plan of study `name` (`"bifurcation"`, `"basins"`, `"image"`) with the keywords
-    /// `request` (the library's request through serde: an unknown key is a `TypeError`, a bad
-    /// value a `ValueError`; for `"image"`, `ImageKeywords`) over `params`; `probe` is the
-    /// probe file's text (the basin map's SI block; the image's probe).
+    /// The plan of study `name` (`"bifurcation"`, `"basins"`, `"image"`, `"fit_map"`) with the
+    /// keywords `request` (the library's request through serde: an unknown key is a
+    /// `TypeError`, a bad value a `ValueError`; for `"image"`, `ImageKeywords`) over `params`;
+    /// `probe` is the probe file's text (the basin map's SI block; the image's and the force
+    /// map's probe).
     #[staticmethod]
     #[pyo3(signature = (name, request=None, params=None, probe=None))]
     fn build(
@@ -58,6 +59,11 @@ impl Plan {
                 let text = probe.ok_or_else(|| value_error("image: the probe is needed"))?;
                 Recipe::image(keywords, &text).map_err(sim_error)?
             }
+            "fit_map" => Recipe::FitMap {
+                request: req(name, request)?,
+                params,
+                probe,
+            },
             _ => return Err(pyo3::exceptions::PyKeyError::new_err(name.to_string())),
         };
         let plan = plan::plan(recipe).map_err(sim_error)?;

@@ -1,6 +1,7 @@
 """The machinery of :mod:`afmdyn.dask` (its public names are re-exported there): the
 clusters, the chart's Zarr ledger, the plans' task runners and the finishers of the generated
-``afmdyn.dask.chart``, ``bifurcation``, ``basins`` and ``image`` (:mod:`._dask_wrappers`)."""
+``afmdyn.dask.chart``, ``bifurcation``, ``basins``, ``image`` and ``fit_map``
+(:mod:`._dask_wrappers`)."""
 
 from __future__ import annotations
 
@@ -334,3 +335,33 @@ def _finish_image(a: Dict[str, Any]) -> xr.Dataset:
     with _cluster(a["client"]) as client:
         d = _run_plan(client, plan, a["progress"], "image (dask)", unit="line")
     return _dataset(d, a["setpoint"])
+
+
+def _finish_fit_map(a: Dict[str, Any]) -> xr.Dataset:
+    """Fit the map of :func:`afmdyn.dask.fit_map`'s keywords ``a`` (its ``locals()``): a line
+    of the map per task, each worker reading its curves from the map file (a path it must
+    read: this machine's for a ``LocalCluster``, a shared filesystem for a cluster's)."""
+    import tempfile
+
+    from ._common import _params, _warn
+    from ._fit_map import _map_dataset, _map_dir, _map_file, _map_request
+
+    request = _map_request(a)
+    p, probe = _params(a["params"], a["model"], quasi_static=True)
+    store = a["store"]
+    with tempfile.TemporaryDirectory(prefix="afmdyn-map-") as tmp:
+        # curves given as data are written where the workers read them: the store, or a
+        # temporary directory of this machine (a LocalCluster's workers share it); the path
+        # as afmdyn.fit_map's (the store's fingerprint holds it: either resumes the other's)
+        request["data"] = _map_file(a["data"], _map_dir(store, tmp))
+        plan = _core.Plan.build("fit_map", request, p, probe)
+        with _cluster(a["client"]) as client:
+            own = None if store is None else plan.store(os.fspath(store))
+            try:
+                d = _run_plan(client, plan, a["progress"], "fit_map (dask)", unit="line",
+                              store=own, resume=a["resume"])
+            finally:
+                if own is not None:
+                    own.release()
+    _warn(d["json"])
+    return _map_dataset(d)

@@ -28,6 +28,7 @@ __all__ = [
     "bifurcation",
     "basins",
     "image",
+    "fit_map",
 ]
 
 
@@ -332,3 +333,67 @@ def image(
         The same ``xarray.Dataset`` as :func:`afmdyn.image` with the same arguments.
     """
     return _dask._finish_image(locals())
+
+
+def fit_map(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = True,
+    data: Union[str, "os.PathLike[str]", Sequence[Any], None] = None,
+    fit: Optional[Sequence[str]] = None,
+    fit_range: Optional[Tuple[float, float]] = None,
+    segment: Optional[str] = None,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """:func:`afmdyn.fit_map` (the same keywords but ``threads``) with the lines of the map
+    mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this machine's
+    cores, closed at the end): each line is a task, its curves read by the worker from the map
+    file and fitted as :func:`afmdyn.fit_map` fits them. The map file (``data``, or the NetCDF
+    file curves given as data are exported to: into ``store``, else a temporary directory of
+    this machine) must be readable by every worker at the same path: a ``LocalCluster`` shares
+    this machine's files; a cluster of several machines needs the map (and ``store``) on a
+    shared filesystem, named by an absolute path.
+
+    With ``store`` (a directory, locked during the run) the fits are kept in the command
+    line's layout (``afmdyn fit-map --out DIR``, ``afmdyn.fit_map(store=...)``): each finished
+    line is appended as it arrives, and a rerun with the same request resumes — from a run of
+    this function, of :func:`afmdyn.fit_map` or of the command line — fitting only the lines
+    not stored (``resume=False`` starts over; another request or map is refused).
+
+    Args:
+        client: a ``dask.distributed.Client`` (default: a ``LocalCluster``).
+        store: a directory keeping the fits in the command line's layout.
+        resume: resume the stored map (``False``: start it over).
+        data: the map: an instrument file afmformats reads (JPK ``.jpk-force-map``, ``.jpk-
+            qi-data``, …; each curve's grid index, position and spring constant from its
+            metadata), a list of afmformats curves or of mappings (``x``, ``y``, ``height``,
+            ``force``, optionally ``ix``, ``iy``, ``segment``, ``time``,
+            ``spring_constant``), both written through :func:`afmdyn.export_map` to a
+            temporary NetCDF file; or a long-format CSV or an ``export_map`` NetCDF file,
+            streamed as they are.
+        fit: The parameters fitted at every curve, by their probe keys (as ``fit``'s:
+            ``sample.youngs_modulus``, ``tip.radius``, ``contact_point``, ``baseline``,
+            ``sample.hamaker`` (DMT), ``sample.adhesion_energy`` (JKR)); the others held at
+            the probe's values. Default ``sample.youngs_modulus``, ``contact_point`` and
+            ``baseline``, as nanite fits a map.
+        fit_range: The range of tip positions fitted [lo, hi] (m, relative to each curve's
+            contact point found by the deviation from the baseline, as nanite's
+            ``range_x``); default the whole segment.
+        segment: The segment fitted: ``approach`` (the default), ``retract`` or ``whole``.
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        The same ``xarray.Dataset`` as :func:`afmdyn.fit_map` with the same arguments, bit for
+        bit (a line's fits are a pure function of the request and the map). Warnings (curves
+        flagged) are raised as :class:`afmdyn.AfmdynWarning`.
+
+    Raises:
+        ValueError: naming the option, the map file or the probe key.
+    """
+    return _dask._finish_fit_map(locals())

@@ -22,23 +22,41 @@ from ._layout import dataset
 _OWN = ("data", "fit", "fit_range", "store", "resume", "progress")
 
 
-def _finish_fit_map(a: Dict[str, Any]) -> xr.Dataset:
-    """Fit the map of :func:`afmdyn.fit_map`'s keywords ``a`` (its ``locals()``)."""
+def _map_request(a: Dict[str, Any]) -> Dict[str, Any]:
+    """The request of :func:`afmdyn.fit_map`'s keywords ``a`` (also
+    :func:`afmdyn.dask.fit_map`'s), but its ``data``."""
     request = {k: v for k, v in _request(a).items() if v is not None and k not in _OWN}
+    request.pop("client", None)
     if a["fit"] is not None:
         request["fit"] = list(a["fit"])
     if a["fit_range"] is not None:
         request["range"] = [float(a["fit_range"][0]), float(a["fit_range"][1])]
+    return request
+
+
+def _map_dir(store: Any, tmp: str) -> str:
+    """Where curves given as data are exported: into the store (a resumed run reads the same
+    file), else ``tmp``."""
+    if store is None:
+        return tmp
+    where = os.fspath(store)
+    os.makedirs(where, exist_ok=True)
+    return where
+
+
+def _finish_fit_map(a: Dict[str, Any]) -> xr.Dataset:
+    """Fit the map of :func:`afmdyn.fit_map`'s keywords ``a`` (its ``locals()``)."""
+    request = _map_request(a)
     p, probe = _params(a["params"], a["model"], quasi_static=True)
     with tempfile.TemporaryDirectory(prefix="afmdyn-map-") as tmp:
-        # curves exported for a store go into it (a resumed run reads the same file)
-        where = tmp
-        if a["store"] is not None:
-            where = os.fspath(a["store"])
-            os.makedirs(where, exist_ok=True)
-        request["data"] = _map_file(a["data"], where)
+        request["data"] = _map_file(a["data"], _map_dir(a["store"], tmp))
         d = _door("fit_map", "curves", a["progress"], p, probe, request, a["store"],
                   a["resume"], stored=True)
+    return _map_dataset(d)
+
+
+def _map_dataset(d: Dict[str, Any]) -> xr.Dataset:
+    """The Dataset of a fitted map's outcome ``d`` (as ``_afmdyn.run`` returns it)."""
     doc = json.loads(d["json"])
     ds = dataset(d["datasets"]["fit_map"], {"law": doc["law"], "summary": json.dumps(doc)})
     flag = ds["flag"]

@@ -20,7 +20,8 @@ from __future__ import annotations
 
 from . import _dask_wrappers
 from ._dask import DONE, ledger_dir, run_chart_task, run_plan_task
-from ._dask_wrappers import *  # noqa: F401,F403 (chart, bifurcation, basins, image: generated)
+# chart, bifurcation, basins, image, fit_map: generated
+from ._dask_wrappers import *  # noqa: F401,F403
 
 __all__ = ["DONE", "ledger_dir", "run_chart_task", "run_plan_task"]
 __all__ += _dask_wrappers.__all__

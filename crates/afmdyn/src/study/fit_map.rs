@@ -96,15 +96,29 @@ impl MapStudy {
 
     /// The study's tasks: the map's lines, each counting its curves.
     pub(crate) fn tasks(&self) -> Tasks<'_, Vec<CurveFit>> {
-        let lines = self.map.lines.len();
-        Tasks::new(&self.fingerprint, lines, move |t, cancel| {
+        Tasks::new(&self.fingerprint, self.lines(), move |t, cancel| {
             self.line(t, cancel)
         })
         .weighted(move |t| self.map.lines[t].len() as u64)
     }
 
+    /// The number of the map's lines (its tasks).
+    pub(crate) fn lines(&self) -> usize {
+        self.map.lines.len()
+    }
+
+    /// What a resumed run must match (the store's fingerprint).
+    #[cfg(feature = "files")]
+    pub(crate) fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
     /// The fits of line `t`'s curves; `None` when cancelled before its end.
-    fn line(&self, t: usize, cancel: &AtomicBool) -> Result<Option<Vec<CurveFit>>, SimError> {
+    pub(crate) fn line(
+        &self,
+        t: usize,
+        cancel: &AtomicBool,
+    ) -> Result<Option<Vec<CurveFit>>, SimError> {
         let range = self.map.lines[t].clone();
         let mut reader = match self.map.reader() {
             Ok(r) => r,

@@ -14,12 +14,18 @@
 //!   line needs (`LineJob`): a worker scans lines without building the study (the
 //!   materials' approach curves, each several lines' time);
 //! - a PeakForce image: stage 0 the materials' engages from far, one task each; stage 1 the
-//!   lines, one task each, whose start is the engages ([`PeakForceImageStudy`]).
+//!   lines, one task each, whose start is the engages ([`PeakForceImageStudy`]);
+//! - a fitted force map (`fit-map`): one stage, one task per line of the map ([`MapStudy`]),
+//!   its start empty: a worker rebuilds the study from the recipe (the map indexed once per
+//!   process) and reads its lines' curves from the map file itself — a path every worker must
+//!   read (the same machine or a shared filesystem); with a store, the command line's
+//!   resumable one ([`Plan::store`]: `afmdyn fit-map --out DIR`).
 //!
 //! The ledger — which tasks a store holds, how the results merge into the outcome — is the
 //! plan's: the executor only maps tasks and hands results back.
 
 use super::basins::BasinStudy;
+use super::fit_map::{every_curve_failed, fit_map_store, CurveFit, MapStudy};
 use super::named::{outcome, Outcome};
 use super::peakforce_image::{Engage, LinePixel, PeakForceImageStudy};
 use super::scan::{LineJob, ScanStudy};
@@ -38,13 +44,13 @@ use crate::request::image::{ImageRequest, SampleMap};
 use crate::request::image_job::ImageKeywords;
 use crate::request::image_scan::ScanRecipe;
 use crate::request::sweep::{every_point_failed, order_key, records, SweepRecord};
-use crate::request::{BasinsRequest, BifurcationRequest, DirLock, Resolved};
+use crate::request::{BasinsRequest, BifurcationRequest, DirLock, FitMapRequest, Resolved};
 use crate::Params;
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::sync::atomic::AtomicBool;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// What rebuilds a plan in any process: the study's name (`"plan"`), its request and model.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -80,6 +86,17 @@ pub enum Recipe {
         map: SampleMap,
         /// The request (its setpoint the peak force in N).
         request: ImageRequest,
+    },
+    /// A force map's fit (`fit-map`) of `request` (its `data` a path every worker reads)
+    /// over `params`; `probe` the probe file's text (SI; required, as `fit-map` requires it:
+    /// the request's validation says so).
+    FitMap {
+        /// The request.
+        request: FitMapRequest,
+        /// The model.
+        params: Params,
+        /// The probe file's text.
+        probe: Option<String>,
     },
 }
 
@@ -221,6 +238,27 @@ fn plan_of(recipe: Recipe, eager: bool) -> Result<Box<dyn Plan>, SimError> {
             study: PeakForceImageStudy::unengaged(&probe, &map, &request)?,
             text,
         }),
+        Recipe::FitMap {
+            request,
+            params,
+            probe,
+        } => {
+            let model = Resolved {
+                params,
+                probe: probe
+                    .as_deref()
+                    .map(|t| crate::probe::Probe::parse(t, "probe"))
+                    .transpose()
+                    .map_err(|e| SimError::Probe(format!("probe {e}")))?,
+            };
+            crate::request::Request::validate(&request, &model)?;
+            Box::new(FitMap {
+                study: Arc::new(MapStudy::new(&request, &model)?),
+                request,
+                model,
+                text,
+            })
+        }
     })
 }
 
@@ -617,6 +655,109 @@ impl Plan for PfImage {
     }
 }
 
+/// A force map's plan: one stage, a task per line of the map.
+struct FitMap {
+    study: Arc<MapStudy>,
+    request: FitMapRequest,
+    model: Resolved,
+    text: String,
+}
+
+/// A fit-map task's result: its line and the line's curves' fits.
+type MapLine = (usize, Vec<CurveFit>);
+
+/// The fitted map's outcome of its lines (any order; every line required), as the one door
+/// gives it (no answer when every curve failed).
+fn map_outcome(
+    study: &MapStudy,
+    request: &FitMapRequest,
+    model: &Resolved,
+    lines: Vec<MapLine>,
+) -> Result<Outcome, SimError> {
+    let map = study.assemble(lines)?;
+    if let Some(e) = every_curve_failed(&map) {
+        return Err(e);
+    }
+    outcome(request, model, &map)
+}
+
+impl Plan for FitMap {
+    fn recipe(&self) -> &str {
+        &self.text
+    }
+    fn stages(&self) -> usize {
+        1
+    }
+    fn stage(&self, stage: usize, _results: &[String]) -> Result<Stage, SimError> {
+        match stage {
+            0 => Ok(Stage {
+                start: String::new(),
+                tasks: (0..self.study.lines()).collect(),
+            }),
+            _ => Err(no_stage(stage, 1)),
+        }
+    }
+    fn run(&self, _start: &str, t: usize, cancel: &AtomicBool) -> Result<String, SimError> {
+        let lines = self.study.lines();
+        if t >= lines {
+            return Err(SimError::out_of_range("task", t, format!("in 0..{lines}")));
+        }
+        let fits = self.study.line(t, cancel)?.ok_or(SimError::Cancelled)?;
+        encode(&(t, fits))
+    }
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
+        let lines = results
+            .iter()
+            .map(|r| decode::<MapLine>("result", r))
+            .collect::<Result<Vec<_>, _>>()?;
+        map_outcome(&self.study, &self.request, &self.model, lines)
+    }
+    fn store(&self, lock: DirLock) -> Option<Box<dyn PlanStore>> {
+        Some(Box::new(MapStore {
+            lock,
+            study: Arc::clone(&self.study),
+            request: self.request.clone(),
+            model: self.model.clone(),
+        }))
+    }
+}
+
+/// The command line's store of a force map (`afmdyn fit-map --out DIR`, `afmdyn.fit_map(store=)`):
+/// a line of fits per finished task, so that a map interrupted anywhere resumes in any of
+/// them, computing only the lines not stored.
+struct MapStore {
+    lock: DirLock,
+    study: Arc<MapStudy>,
+    request: FitMapRequest,
+    model: Resolved,
+}
+
+impl PlanStore for MapStore {
+    fn open(&mut self, resume: bool) -> Result<Option<Vec<usize>>, StudyError> {
+        let lines = self.study.lines();
+        let opened = fit_map_store(&self.lock).open(
+            self.study.fingerprint(),
+            resume,
+            |done: &HashSet<usize>| done.len() >= lines,
+        )?;
+        Ok(match opened {
+            Opened::Finished => None,
+            Opened::Run(done) => Some((0..lines).filter(|t| !done.contains(t)).collect()),
+        })
+    }
+    fn append(&mut self, result: &str) -> Result<(), StudyError> {
+        let line: MapLine = decode("result", result)?;
+        Ok(fit_map_store(&self.lock).append(line)?)
+    }
+    fn finish(&mut self) -> Result<(), StudyError> {
+        Ok(fit_map_store(&self.lock).finish(self.study.fingerprint())?)
+    }
+    fn outcome(&mut self) -> Result<Outcome, StudyError> {
+        let lines = fit_map_store(&self.lock).records()?;
+        Ok(map_outcome(&self.study, &self.request, &self.model, lines)?)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -645,5 +786,96 @@ mod tests {
         assert_eq!(out.datasets.len(), 1);
         assert!(p.stage(2, &results).is_err());
         assert!(rebuild("{\"plan\": \"nope\"}").is_err());
+    }
+
+    /// A 3 × 2 map of Hertz approaches (the probe's R, k and ν) as the long-format CSV, in a
+    /// fresh directory: its path.
+    fn small_map(name: &str) -> std::path::PathBuf {
+        use std::fmt::Write as _;
+        let dir = std::env::temp_dir().join(format!("afmdyn-plan-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut text = String::from("x,y,height,force\n");
+        for iy in 0..2 {
+            for ix in 0..3 {
+                let kh = 4.0 / 3.0 * 5e3 * (1.0 + ix as f64) / 0.75 * 5e-6_f64.sqrt();
+                for i in 0..200 {
+                    let x = 1e-6 - 2.5e-6 * i as f64 / 199.0;
+                    let f = kh * (-x).max(0.0).powf(1.5) + 1e-12 * ((i * 7 + ix) % 5) as f64;
+                    let (x0, y0) = (ix as f64 * 1e-6, iy as f64 * 1e-6);
+                    writeln!(text, "{x0:e},{y0:e},{:e},{f:e}", x - f / 0.05).unwrap();
+                }
+            }
+        }
+        let path = dir.join("map.csv");
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    #[test]
+    fn a_map_from_its_lines_is_the_map_bit_for_bit_and_its_store_resumes() {
+        let path = small_map("fit-map");
+        let probe = include_str!("../../../../examples/probe-fit-hertz.toml");
+        let request = FitMapRequest {
+            data: Some(path.display().to_string()),
+            ..FitMapRequest::default()
+        };
+        let parsed = crate::probe::Probe::parse(probe, "probe").unwrap();
+        let recipe = Recipe::FitMap {
+            request: request.clone(),
+            params: parsed.params,
+            probe: Some(probe.into()),
+        };
+        let p = rebuild(&serde_json::to_string(&recipe).unwrap()).expect("plan");
+        let cancel = AtomicBool::new(false);
+        let st = p.stage(0, &[]).expect("stage");
+        assert_eq!(st.tasks, vec![0, 1]);
+        let results: Vec<String> = st
+            .tasks
+            .iter()
+            .rev()
+            .map(|&t| p.run(&st.start, t, &cancel).expect("line"))
+            .collect();
+        let out = p.outcome(&results).expect("outcome");
+        // the one door's run of the same request
+        let model = Resolved {
+            params: parsed.params,
+            probe: Some(parsed),
+        };
+        let map = crate::request::run::Analysis::execute(&request, &model, &Default::default())
+            .expect("map");
+        let door = outcome(&request, &model, &map).expect("outcome");
+        assert_eq!(out.document, door.document);
+        assert_eq!(out.facts, door.facts);
+        assert_eq!(
+            format!("{:?}", out.datasets),
+            format!("{:?}", door.datasets)
+        );
+        assert!(p.stage(1, &results).is_err() && p.run("", 2, &cancel).is_err());
+        // a store: one line appended, then resumed; the other line is all that is left
+        let dir = path.with_file_name("store");
+        let lock = || DirLock::acquire(&dir).expect("lock");
+        let mut s = p.store(lock()).expect("a store");
+        assert_eq!(s.open(true).expect("open"), Some(vec![0, 1]));
+        s.append(&results[1]).expect("append");
+        drop(s);
+        let mut s = p.store(lock()).expect("a store");
+        assert_eq!(s.open(true).expect("open"), Some(vec![1]));
+        s.append(&results[0]).expect("append");
+        s.finish().expect("finish");
+        assert_eq!(s.outcome().expect("outcome").document, door.document);
+        drop(s);
+        let mut s = p.store(lock()).expect("a store");
+        assert_eq!(
+            s.open(true).expect("open"),
+            None,
+            "finished: nothing to run"
+        );
+        assert_eq!(
+            s.open(false).expect("open"),
+            Some(vec![0, 1]),
+            "started over"
+        );
+        drop(s);
+        let _ = std::fs::remove_dir_all(path.parent().unwrap());
     }
 }
