@@ -140,11 +140,12 @@ LONG = {
         """,
         "afmdyn.fit(data=curve, probe=EX + '/probe-fit-hertz.toml', profiles=True, progress=p)",
     ),
-    # a 50 × 50 map of such curves of 600 rows (a second of fitting), written by export_map
+    # a 50 × 50 map of such curves of 6000 rows (seconds of fitting, so that the signal lands
+    # in the fits, not in the Dataset's assembly after them), written by export_map
     "fit_map": (
         """
         import tempfile
-        x = np.linspace(1e-6, -1.5e-6, 600)
+        x = np.linspace(1e-6, -1.5e-6, 6000)
         f = 4 / 3 * (10e3 / 0.75) * np.sqrt(5e-6) * np.clip(-x, 0, None) ** 1.5
         curves = [{"x": (c % 50) * 1e-6, "y": (c // 50) * 1e-6, "height": x - f / 0.05,
                    "force": f} for c in range(2500)]
