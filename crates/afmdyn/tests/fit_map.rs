@@ -222,3 +222,30 @@ fn malformed_maps_are_refused_naming_the_file() {
         );
     }
 }
+
+/// A map fitted with another lever's probe (RTESPA-300, k ≈ 40 N/m, against the map's
+/// 0.05 N/m: forces 10⁻⁴ of what its deflection allows over the heights' span) says, in the
+/// map's warnings, that its curves' data look off against the probe; the map's own probe does
+/// not.
+#[test]
+fn a_map_fitted_with_another_levers_probe_says_its_data_look_off() {
+    let path = map("lever");
+    let text = include_str!("../../../examples/probe-rtespa300-polystyrene.toml");
+    let p = afmdyn::probe::Probe::parse(text, "rtespa300").expect("probe");
+    let other = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let says = |model: &Resolved| -> bool {
+        let doc = run(&request(&path, 2), model, &Progress::default())
+            .expect("fit-map")
+            .json;
+        doc["warnings"].as_array().unwrap().iter().any(|w| {
+            w.as_str()
+                .unwrap()
+                .contains("data look off against the probe")
+        })
+    };
+    assert!(says(&other));
+    assert!(!says(&probe()));
+}

@@ -112,7 +112,8 @@ fn curve_entry(m: &FitMap, c: &CurveFit) -> Value {
     })
 }
 
-/// The caveats of a fitted map: the curves flagged, with the first reason of each flag.
+/// The caveats of a fitted map: the curves flagged, with the first reason of each flag, and
+/// the curves whose data look off against the probe (`fit`'s data warnings), with the first.
 fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> {
     let total = m.curves.len();
     let mut w = Vec::new();
@@ -133,6 +134,21 @@ fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> 
                 first.reason.as_deref().unwrap_or("")
             ));
         }
+    }
+    let slips: Vec<&CurveFit> = m
+        .curves
+        .iter()
+        .filter(|c| c.data_warning.is_some())
+        .collect();
+    if let Some(first) = slips.first() {
+        w.push(format!(
+            "{} of {total} curves' data look off against the probe: the first at x = {:.4e} m, \
+             y = {:.4e} m: {}",
+            slips.len(),
+            first.x,
+            first.y,
+            first.data_warning.as_deref().unwrap_or("")
+        ));
     }
     w
 }

@@ -174,7 +174,7 @@ fn sls_start_warning(model: &SlsCurveModel, p: &[f64]) -> Option<String> {
 /// against a piezo's travel (1 nm to 100 µm), the forces' span against what the lever's
 /// deflection over that span allows (k × the heights' span, from 10⁻⁴ of it on a soft sample
 /// to 10 times it).
-fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String> {
+pub(crate) fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String> {
     use crate::request::quantity::{span, unit_slip, Dim};
     let h = span(height);
     let slips = [

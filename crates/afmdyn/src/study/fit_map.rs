@@ -194,6 +194,9 @@ impl MapStudy {
             contact_height: finite(contact_height),
             flag,
             reason,
+            data_warning: super::fit::data_warnings(&rows.height, &rows.force, k)
+                .into_iter()
+                .next(),
             shown,
         }
     }
@@ -254,6 +257,7 @@ fn failed(c: &MapCurve, n: usize, reason: String) -> CurveFit {
         contact_height: None,
         flag: CurveFlag::Failed,
         reason: Some(reason),
+        data_warning: None,
         shown: None,
     }
 }

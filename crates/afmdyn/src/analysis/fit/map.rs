@@ -83,6 +83,10 @@ pub struct CurveFit {
     pub flag: CurveFlag,
     /// Why it is flagged (`None` when fitted).
     pub reason: Option<String>,
+    /// The first of the curve's columns held against the probe that looks off (a unit slip,
+    /// a lever of another spring constant: `fit`'s data warning), whatever its flag.
+    #[serde(default)]
+    pub data_warning: Option<String>,
     /// The curve with its fit, for the few shown.
     pub shown: Option<ShownCurve>,
 }
