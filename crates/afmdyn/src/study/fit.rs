@@ -236,7 +236,7 @@ impl Analysis for FitRequest {
         let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
         let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
         let sig: Option<Vec<f64>> = sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
-        let names = force_curve::parameter_names(law)
+        let names = force_curve::parameter_names_of(law, &s.tip_shape)
             .unwrap_or_default()
             .to_vec();
         let params = start_values(&names, &s, &x, &y)?;
@@ -273,6 +273,7 @@ impl Analysis for FitRequest {
                         probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
                     ),
                     intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+                    indenter: self.indenter(&s)?,
                 };
                 &elastic
             }
