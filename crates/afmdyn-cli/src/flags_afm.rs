@@ -141,6 +141,15 @@ pub struct FitFlags {
     /// `--no-profiles`: the request's `profiles` false.
     #[arg(long, help = "Turns --profiles off (not given: the default).")]
     pub no_profiles: bool,
+    /// `--bonded`: the request's `bonded`.
+    #[arg(long, conflicts_with = "no_bonded", help = "Whether the sample is bonded to the substrate (glued; the default, true) or free to slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the sphere only). Used with --thickness.")]
+    pub bonded: bool,
+    /// `--no-bonded`: the request's `bonded` false.
+    #[arg(long, help = "Turns --bonded off (not given: the default).")]
+    pub no_bonded: bool,
+    /// `--thickness`: the request's `thickness`.
+    #[arg(long, allow_hyphen_values = true, help = "The sample's thickness h (m, > 0) above a rigid substrate: the Hertz law's force is corrected for the bottom effect (Dimitriadis et al., *Biophys. J.* 82 (2002) 2798 for the paraboloid and the sphere; Garcia & Garcia, *Biophys. J.* 114 (2018) 2923 for the cone, the pyramids and the flat punch, an incompressible sample, ν 0.45–0.5). Default none: a sample infinitely thick. With --probe a unit may follow (20nm).")]
+    pub thickness: Option<Quantity>,
 }
 
 impl FitFlags {
@@ -151,11 +160,13 @@ impl FitFlags {
     pub fn request(&self, si: bool) -> Result<FitRequest, CliError> {
         Ok(FitRequest {
             approach_rows: self.approach_rows,
+            bonded: either(self.bonded, self.no_bonded),
             data: self.data.clone(),
             fit: self.fit.clone(),
             profiles: either(self.profiles, self.no_profiles),
             range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
             segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
+            thickness: quantity(self.thickness, "thickness", Dim::Length, si)?,
             ..FitRequest::default()
         })
     }

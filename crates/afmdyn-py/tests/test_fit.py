@@ -189,6 +189,87 @@ def test_a_measured_jpk_curve_fits_as_nanite_fits_it():
     assert lo < ref["E"].value < hi
 
 
+def _nanite_jpk(model_key, module, **held):
+    """nanite 4.2's fit of the JPK curve with ``model_key`` (its module's defaults, the
+    baseline free, the held parameters ``held`` set), after its three preprocessing steps: the
+    fitted parameters and the largest indentation of the fitted rows (m)."""
+    nanite = pytest.importorskip("nanite")
+    idnt = nanite.IndentationGroup(JPK)[0]
+    idnt.apply_preprocessing(["compute_tip_position", "correct_force_offset", "correct_tip_offset"])
+    params = module.get_parameter_defaults()
+    params["baseline"].vary = True
+    for key, value in held.items():
+        params[key].set(value)
+    idnt.fit_model(model_key=model_key, params_initial=params, range_x=(0, 0),
+                   range_type="absolute", x_axis="tip position", y_axis="force",
+                   segment="approach", weight_cp=False)
+    ref = idnt.fit_properties["params_fitted"]
+    approach = np.asarray(idnt["segment"]) == 0
+    depth = ref["contact_point"].value - np.min(np.asarray(idnt["tip position"])[approach])
+    return ref, depth
+
+
+def _afmdyn_jpk(tip):
+    """afmdyn's fit of the JPK curve (E, contact point, baseline) with the ``[tip]`` lines
+    ``tip`` in place of the probe's radius: E (Pa)."""
+    text = open(JPK_PROBE).read().replace("radius = 10e-6", tip)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ds = afmdyn.fit(probe=text, data=JPK, fit=FIT)
+    return ds["estimate"].sel(parameter="sample.youngs_modulus").item()
+
+
+@pytest.mark.parametrize("model_key, module, angle, tip", [
+    ("hertz_cone", "model_conical_indenter", 25.0, 'shape = "cone"\nhalf_angle = 25'),
+    ("hertz_pyr3s", "model_hertz_three_sided_pyramid", 15.0,
+     'shape = "pyramid-3"\nface_angle = 15'),
+])
+def test_a_measured_curve_fits_with_a_sharp_tip_as_nanite_fits_it(model_key, module, angle, tip):
+    """The JPK curve with nanite's cone (half angle 25°) and three-sided pyramid (face angle
+    15°): afmdyn's E agrees with nanite 4.2's within 0.1 %."""
+    pytest.importorskip("afmformats")
+    nanite = pytest.importorskip("nanite")
+    ref, _ = _nanite_jpk(model_key, getattr(nanite.model, module), alpha=angle)
+    e = _afmdyn_jpk(tip)
+    assert abs(e / ref["E"].value - 1) < 1e-3, (e, ref["E"].value)
+
+
+def _sneddon_sphere(delta, radius):
+    """Sneddon's exact sphere per unit E* (1965, eqs. 6.13 and 6.15): δ = (a/2) ln((R+a)/(R−a)),
+    F = ½[(a² + R²) ln((R+a)/(R−a)) − 2aR], a found by bisection."""
+    lo, hi = 0.0, radius * (1 - 1e-15)
+    for _ in range(200):
+        a = 0.5 * (lo + hi)
+        if a / 2 * np.log((radius + a) / (radius - a)) < delta:
+            lo = a
+        else:
+            hi = a
+    a = 0.5 * (lo + hi)
+    log = np.log((radius + a) / (radius - a))
+    return 0.5 * ((a * a + radius * radius) * log - 2 * a * radius)
+
+
+def test_the_exact_sphere_agrees_with_nanites_approximation_within_its_error():
+    """nanite's ``sneddon_spher_approx`` (Sneddon's sphere truncated at (δ/R)⁴) against
+    afmdyn's exact sphere on the JPK curve (R = 10 µm): the two E agree within the
+    approximation's error, the relative difference of the truncated and the exact force at the
+    deepest indentation fitted (stated here: computed from both forms), plus the 1e-4 of the
+    paraboloid's agreement; and the paraboloid's fit is unchanged by the shapes."""
+    pytest.importorskip("afmformats")
+    nanite = pytest.importorskip("nanite")
+    radius = 10e-6
+    ref, depth = _nanite_jpk("sneddon_spher_approx",
+                             nanite.model.model_sneddon_spherical_approximation, R=radius)
+    d = depth / radius
+    series = 1 - d / 10 - d ** 2 / 840 + 11 * d ** 3 / 15120 + 1357 * d ** 4 / 6652800
+    paraboloid = 4 / 3 * np.sqrt(radius) * depth ** 1.5
+    error = abs(paraboloid * series / _sneddon_sphere(depth, radius) - 1)
+    e = _afmdyn_jpk('shape = "sphere"\nradius = 10e-6')
+    assert abs(e / ref["E"].value - 1) < error + 1e-4, (e, ref["E"].value, d, error)
+    # the paraboloid written out is the default
+    assert _afmdyn_jpk('shape = "paraboloid"\nradius = 10e-6') == _afmdyn_jpk("radius = 10e-6")
+
+
 def test_a_frequency_shift_curve_fits_against_the_fm_model(tmp_path):
     """A Δf curve made by ``afmdyn.fm`` (the probe's E and H, z = z_c − 1 nm, 0.2 Hz of seeded
     noise) is fitted as an FM curve: the Dataset carries the frequency shift's data, fit and

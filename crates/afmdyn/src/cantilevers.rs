@@ -161,12 +161,19 @@ pub(crate) fn fill(root: &toml::Table) -> Result<toml::Table, String> {
     }
     out.insert("cantilever".into(), toml::Value::Table(cantilever));
     let mut tip = section(&mut out, "tip");
+    // a sharp indenter (a cone, a pyramid) has no radius (contact::indenter)
+    let sharp = tip
+        .get("shape")
+        .and_then(|s| s.as_str())
+        .is_some_and(|s| crate::contact::indenter::TipShape::angle_key(s.trim()).is_some());
     for (k, v) in [
         ("radius", c.radius),
         ("youngs_modulus", SILICON_YOUNGS_MODULUS),
         ("poisson_ratio", SILICON_POISSON_RATIO),
     ] {
-        tip.entry(k).or_insert(toml::Value::Float(v));
+        if !(sharp && k == "radius") {
+            tip.entry(k).or_insert(toml::Value::Float(v));
+        }
     }
     out.insert("tip".into(), toml::Value::Table(tip));
     Ok(out)

@@ -325,6 +325,7 @@ laws! {
     spring_adhesion => SpringAdhesion { toy_adhesion } : SpringAdhesionLaw,
 }
 
+pub(crate) mod indenter;
 mod law;
 mod prepared;
 pub use capillary::{

@@ -73,6 +73,7 @@ fn the_sensitivities_match_central_differences() {
             poisson_ratio: 0.5,
             tip: (1.69e11, 0.27),
             intermolecular_distance: 0.3e-9,
+            indenter: Default::default(),
         };
         let (rows, n) = (m.points(), p.len());
         let mut v = vec![0.0; rows];
@@ -473,6 +474,7 @@ fn the_contact_rows_minimum_is_the_whole_curves() {
         poisson_ratio: NU,
         tip: (afmdyn::cantilevers::SILICON_YOUNGS_MODULUS, 0.27),
         intermolecular_distance: 0.0,
+        indenter: Default::default(),
     };
     let p = |name: &str, start: f64, lower: f64, scale: f64| Parameter {
         name: name.into(),
@@ -519,4 +521,219 @@ fn the_contact_rows_minimum_is_the_whole_curves() {
     }
     assert!((whole.chi2 / reduced.chi2 - 1.0).abs() < 1e-9);
     assert_eq!(whole.dof, reduced.dof);
+}
+
+/// A probe of the lever and sample of examples/probe-fit-hertz.toml with the `[tip]` table
+/// `tip` (and the law `law`), read for a force curve.
+fn shape_probe(tip: &str, law: &str) -> Resolved {
+    let adhesion = match law {
+        "dmt" => "hamaker = 1e-20",
+        "jkr" => "adhesion_energy = 1e-3",
+        _ => "",
+    };
+    let text = format!(
+        "model = \"point-mass\"\n[cantilever]\nspring_constant = {K}\nresonance_frequency = \
+         10e3\nquality_factor = 50\n[tip]\n{tip}\n[sample]\nlaw = \"{law}\"\nyoungs_modulus = \
+         10e3\npoisson_ratio = {NU}\n{adhesion}\n"
+    );
+    let p = Probe::parse_for(&text, "shape", afmdyn::probe::ProbeNeeds::Static).expect("probe");
+    Resolved {
+        params: p.params,
+        probe: Some(p),
+    }
+}
+
+/// E* of the sample E_TRUE, ν = NU, under the probe's silicon tip (Johnson 1985, eq. 4.22).
+fn e_star() -> f64 {
+    1.0 / ((1.0 - 0.27 * 0.27) / afmdyn::cantilevers::SILICON_YOUNGS_MODULUS
+        + (1.0 - NU * NU) / E_TRUE)
+}
+
+/// A noise-free approach of `rows` tip positions from +1 µm to −1.5 µm about the contact at 0,
+/// with the force `f(δ)` (N) at indentation δ (m): the piezo heights x − F/k and the forces.
+fn curve_of(f: impl Fn(f64) -> f64) -> (Vec<f64>, Vec<f64>) {
+    let rows = 1000;
+    (0..rows)
+        .map(|i| {
+            let x = 1e-6 - 2.5e-6 * i as f64 / (rows - 1) as f64;
+            let force = if x < 0.0 { f(-x) } else { 0.0 };
+            (x - force / K, force)
+        })
+        .unzip()
+}
+
+/// The fitted E of `curve` under `probe`, with E, the contact point and the baseline free.
+fn fitted_modulus(probe: &Resolved, curve: (Vec<f64>, Vec<f64>), thickness: Option<f64>) -> f64 {
+    let req = FitRequest {
+        thickness,
+        ..request(
+            curve.0,
+            curve.1,
+            &[YOUNGS_MODULUS, "contact_point", "baseline"],
+        )
+    };
+    let doc = run(&req, probe, &Progress::default()).expect("fit");
+    doc.json["estimates"][YOUNGS_MODULUS]["value"]
+        .as_f64()
+        .unwrap()
+}
+
+/// Every indenter shape: a noise-free curve of its closed form (written here: Hertz, Sneddon's
+/// cone and exact sphere in its parametric form, nanite's `hertz_pyr3s`, Bilodeau's
+/// four-sided pyramid, the flat punch) fitted back to its E.
+#[test]
+fn a_curve_of_each_shape_fits_back_to_its_modulus() {
+    let es = e_star();
+    let tan = |deg: f64| deg.to_radians().tan();
+    // Sneddon's sphere: δ(a) = (a/2) ln((R+a)/(R−a)), F(a) = (E*/2)[(a²+R²) ln(…) − 2aR],
+    // inverted by bisection on a
+    let sphere = move |delta: f64| {
+        let (mut lo, mut hi) = (0.0, R * (1.0 - 1e-12));
+        for _ in 0..200 {
+            let a = 0.5 * (lo + hi);
+            if a / 2.0 * ((R + a) / (R - a)).ln() < delta {
+                lo = a;
+            } else {
+                hi = a;
+            }
+        }
+        let a = 0.5 * (lo + hi);
+        let l = ((R + a) / (R - a)).ln();
+        es / 2.0 * ((a * a + R * R) * l - 2.0 * a * R)
+    };
+    type Force = Box<dyn Fn(f64) -> f64>;
+    let cases: Vec<(&str, Force)> = vec![
+        (
+            "radius = 5e-6",
+            Box::new(move |d: f64| 4.0 / 3.0 * es * R.sqrt() * d.powf(1.5)),
+        ),
+        ("shape = \"sphere\"\nradius = 5e-6", Box::new(sphere)),
+        (
+            "shape = \"cone\"\nhalf_angle = 25",
+            Box::new(move |d: f64| 2.0 / std::f64::consts::PI * es * tan(25.0) * d * d),
+        ),
+        (
+            "shape = \"pyramid-3\"\nface_angle = 15",
+            Box::new(move |d: f64| 0.8887 * es * tan(15.0) * d * d),
+        ),
+        (
+            "shape = \"pyramid-4\"\nhalf_angle = 35",
+            Box::new(move |d: f64| es * tan(35.0) / 2f64.sqrt() * d * d),
+        ),
+        (
+            "shape = \"flat-punch\"\nradius = 1e-6",
+            Box::new(move |d: f64| 2.0 * es * 1e-6 * d),
+        ),
+    ];
+    for (tip, f) in cases {
+        let e = fitted_modulus(&shape_probe(tip, "hertz"), curve_of(f), None);
+        assert!((e / E_TRUE - 1.0).abs() < 1e-6, "{tip}: {e}");
+    }
+}
+
+/// A thin sample: the paraboloid's curve with Dimitriadis et al.'s bonded series (α₀, β₀ at
+/// ν = 0.5, written here) and the cone's with Garcia & Garcia's, fitted back with the
+/// `thickness`; and the same curves fitted without it read a stiffer sample.
+#[test]
+fn a_thin_sample_fits_back_with_its_thickness() {
+    let (es, h) = (e_star(), 3e-6);
+    let pi = std::f64::consts::PI;
+    let a0 = -(1.2876 - 1.4678 * NU + 1.3442 * NU * NU) / (1.0 - NU);
+    let b0 = (0.6387 - 1.0277 * NU + 1.5164 * NU * NU) / (1.0 - NU);
+    let para = move |d: f64| {
+        let x = (R * d).sqrt() / h;
+        let c = 1.0 - 2.0 * a0 / pi * x + 4.0 * a0 * a0 / (pi * pi) * x * x
+            - 8.0 / pi.powi(3) * (a0.powi(3) + 4.0 * pi * pi / 15.0 * b0) * x.powi(3)
+            + 16.0 * a0 / pi.powi(4) * (a0.powi(3) + 3.0 * pi * pi / 5.0 * b0) * x.powi(4);
+        4.0 / 3.0 * es * R.sqrt() * d.powf(1.5) * c
+    };
+    let t = 25f64.to_radians().tan();
+    let cone = move |d: f64| {
+        let b = d * t / h;
+        let c = 1.0 + 0.721 * b + 0.650 * b * b + 0.491 * b.powi(3) + 0.225 * b.powi(4);
+        2.0 / pi * es * t * d * d * c
+    };
+    for (tip, f) in [
+        ("radius = 5e-6", Box::new(para) as Box<dyn Fn(f64) -> f64>),
+        ("shape = \"cone\"\nhalf_angle = 25", Box::new(cone)),
+    ] {
+        let probe = shape_probe(tip, "hertz");
+        let e = fitted_modulus(&probe, curve_of(&f), Some(h));
+        assert!((e / E_TRUE - 1.0).abs() < 1e-6, "{tip}: {e}");
+        let e = fitted_modulus(&probe, curve_of(&f), None);
+        assert!(e > 1.05 * E_TRUE, "{tip}: {e}");
+    }
+}
+
+/// The shapes' refusals, each naming its field: an adhesive law with a cone (`tip.shape`), a
+/// thickness under DMT (`thickness`), `bonded` without a thickness, a non-bonded cone
+/// (`bonded`); the dynamic analyses' read of a cone probe names `[tip].shape`; an angle in
+/// radians is read with a warning naming radians.
+#[test]
+fn the_shapes_refusals_name_their_fields() {
+    let (h, f) = synthetic(300, 0.0, 1);
+    let name = |probe: &Resolved, req: FitRequest| match run(&req, probe, &Progress::default()) {
+        Err(afmdyn::SimError::OutOfRange { name, .. }) => name,
+        other => panic!("{:?}", other.map(|d| d.json)),
+    };
+    let fit = |thickness, bonded| FitRequest {
+        thickness,
+        bonded,
+        ..request(h.clone(), f.clone(), &[YOUNGS_MODULUS, "contact_point"])
+    };
+    let cone = "shape = \"cone\"\nhalf_angle = 25";
+    assert_eq!(
+        name(&shape_probe(cone, "dmt"), fit(None, None)),
+        "tip.shape"
+    );
+    assert_eq!(
+        name(&shape_probe(cone, "jkr"), fit(None, None)),
+        "tip.shape"
+    );
+    let para = "radius = 5e-6";
+    assert_eq!(
+        name(&shape_probe(para, "dmt"), fit(Some(1e-6), None)),
+        "thickness"
+    );
+    assert_eq!(
+        name(&shape_probe(para, "hertz"), fit(None, Some(false))),
+        "bonded"
+    );
+    assert_eq!(
+        name(&shape_probe(para, "hertz"), fit(Some(-1e-6), None)),
+        "thickness"
+    );
+    assert_eq!(
+        name(&shape_probe(cone, "hertz"), fit(Some(1e-6), Some(false))),
+        "bonded"
+    );
+    // the cone has no tip.radius to fit
+    let radius = request(h.clone(), f.clone(), &[YOUNGS_MODULUS, "tip.radius"]);
+    assert_eq!(name(&shape_probe(cone, "hertz"), radius), "fit");
+    // the dynamic analyses take the paraboloid only
+    let text = include_str!("../../../examples/probe-fit-hertz.toml")
+        .replace("radius = 5e-6", "shape = \"pyramid-4\"\nhalf_angle = 35");
+    let e = Probe::parse(&text, "p").unwrap_err().to_string();
+    assert!(e.contains("[tip].shape = \"pyramid-4\""), "{e}");
+    // an angle in radians: read, with a warning naming the slip
+    let p = shape_probe("shape = \"cone\"\nhalf_angle = 0.436", "hertz");
+    let w = p.probe.unwrap().warnings().join("; ");
+    assert!(
+        w.contains("[tip].half_angle") && w.contains("radians"),
+        "{w}"
+    );
+    // an angle of another shape, a missing angle, an unknown shape: problems of the file
+    for (tip, word) in [
+        ("shape = \"cone\"\nface_angle = 15", "[tip].face_angle"),
+        ("shape = \"pyramid-3\"", "missing key [tip].face_angle"),
+        ("shape = \"wedge\"", "[tip].shape = 'wedge'"),
+        ("shape = \"cone\"\nhalf_angle = 90", "[tip].half_angle = 90"),
+    ] {
+        let text =
+            include_str!("../../../examples/probe-fit-hertz.toml").replace("radius = 5e-6", tip);
+        let e = Probe::parse_for(&text, "p", afmdyn::probe::ProbeNeeds::Static)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(word), "{tip}: {e}");
+    }
 }

@@ -433,6 +433,7 @@ FitRequest = TypedDict(
     "FitRequest",
     {
         "approach_rows": Optional[int],  # default null
+        "bonded": Optional[bool],  # default null
         "data": Optional[str],  # default null
         "fit": List[str],  # default ["sample.youngs_modulus", "contact_point"]
         "force": List[float],  # default []
@@ -441,6 +442,7 @@ FitRequest = TypedDict(
         "range": Optional[List[float]],  # default null
         "segment": Optional[Literal["approach", "retract", "whole"]],  # default null
         "sigma": Optional[List[float]],  # default null
+        "thickness": Optional[float],  # default null
         "time": List[float],  # default []
     },
     total=False,

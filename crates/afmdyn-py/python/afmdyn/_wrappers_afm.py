@@ -741,17 +741,19 @@ def peakforce(
     return _peakforce._finish_peakforce(locals())
 
 
-@_typed(si={"fit_range": "length"})
+@_typed(si={"fit_range": "length", "thickness": "length"})
 def fit(
     params: Optional[Params] = None,
     /,
     *,
     approach_rows: Optional[int] = None,
+    bonded: Optional[bool] = None,
     data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
     fit: Optional[Sequence[str]] = None,
     profiles: Optional[bool] = None,
     fit_range: Optional[Tuple[float, float]] = None,
     segment: Optional[str] = None,
+    thickness: Optional[float] = None,
     curve: int = 0,
     progress: ProgressArg = None,
     **model: Unpack[Model],
@@ -769,6 +771,9 @@ def fit(
             reads from an instrument file); default up to the lowest piezo height,
             inclusive. 1 to the number of rows. For an afmformats curve the default is the
             instrument's segments.
+        bonded: Whether the sample is bonded to the substrate (glued; the default, true) or
+            free to slide on it (false: Dimitriadis et al.'s non-bonded series, of the
+            paraboloid and the sphere only). Used with ``thickness``.
         data: the force curve: a CSV file with the columns ``height`` (m, the piezo height,
             decreasing into the sample), ``force`` (N, repulsion positive) and optionally
             ``sigma`` (N) and ``time`` (s, which the ``sls`` law needs); or a mapping (a
@@ -805,6 +810,11 @@ def fit(
             default the whole segment.
         segment: The segment fitted: ``approach``, ``retract`` or ``whole``; default the
             approach, the whole curve for the ``sls`` law.
+        thickness: The sample's thickness h (m, > 0) above a rigid substrate: the Hertz
+            law's force is corrected for the bottom effect (Dimitriadis et al., *Biophys.
+            J.* 82 (2002) 2798 for the paraboloid and the sphere; Garcia & Garcia, *Biophys.
+            J.* 114 (2018) 2923 for the cone, the pyramids and the flat punch, an
+            incompressible sample, ν 0.45–0.5). Default none: a sample infinitely thick.
         curve: which curve of an afmformats file with several (a force map), from 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.

@@ -15,6 +15,10 @@
 //! radius = 10e-9                 # R (m)
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
 //! poisson_ratio = 0.27           # ν_t, default 0.27 (silicon, units::SILICON_TIP)
+//! # shape = "paraboloid"         # the indenter of `afmdyn fit` (contact::indenter): paraboloid
+//! #                              # (default) | sphere | flat-punch (with radius) | cone |
+//! #                              # pyramid-4 (half_angle, degrees) | pyramid-3 (face_angle,
+//! #                              # degrees); the dynamic analyses take the paraboloid only
 //! [sample]
 //! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | capillary | sls
 //!                                # | impact
@@ -123,10 +127,16 @@ use reader::*;
 
 pub use crate::contact::VACUUM_PERMITTIVITY;
 
+/// The radius (m) a probe of a sharp indenter (`[tip] shape` a cone or a pyramid) without
+/// `[tip] radius` resolves its dimensionless Hertz group with: no analysis that takes such a
+/// shape reads it (the force-curve fit uses the angle; the dynamic analyses refuse the shape).
+pub(crate) const SHAPE_STAND_IN_RADIUS: f64 = 10e-9;
+
 /// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
 /// (Israelachvili 2011, §13.6).
 pub(crate) const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 
+use crate::contact::indenter::TipShape;
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
@@ -371,6 +381,8 @@ pub struct SampleInputs {
     pub maxwell_stiffness: Option<f64>,
     /// `[sample] relaxation_time` (s, the SLS Maxwell arm's τ_r = η/k₂).
     pub relaxation_time: Option<f64>,
+    /// `[tip] shape` with its angle (the paraboloid when omitted).
+    pub(crate) tip_shape: TipShape,
 }
 
 /// The indentation, as a fraction of the tip radius, beyond which the paraboloid contact of
@@ -544,6 +556,8 @@ struct Sample {
     si: crate::contact::SampleSi,
     z_c: Option<f64>,
     elastic: Option<[f64; 4]>,
+    /// `[tip] shape`.
+    shape: TipShape,
 }
 
 /// A probe as a front end receives it: a file (the command line's `--probe FILE`, Python's
@@ -714,6 +728,17 @@ impl Probe {
         };
         let mut problems = Vec::new();
         let probe = Self::read(&root, &mut problems);
+        // the dynamic analyses' laws are the paraboloid's (contact::indenter)
+        let shape = probe.as_ref().map(|p| p.sample_inputs.tip_shape);
+        if let Some(shape) =
+            shape.filter(|s| needs != ProbeNeeds::Static && *s != TipShape::Paraboloid)
+        {
+            problems.push(format!(
+                "[tip].shape = \"{}\": the dynamic analyses take the paraboloid (the contact \
+                 laws' Hertz contact); the other shapes are afmdyn fit's, on force curves",
+                shape.name()
+            ));
+        }
         match probe {
             Some(mut p) if problems.is_empty() => {
                 p.input_warnings

@@ -70,6 +70,17 @@ pub(crate) const SI_RANGES: &[SiRange] = &[
         ..SiRange::NONE
     },
     SiRange {
+        // an indenter's angle (contact::indenter): the half angles of AFM cones and pyramids
+        // are about 10–45° (nanite's default cone, 25°); a value in radians reads as < 1.6°
+        sections: &["tip"],
+        keys: &["half_angle", "face_angle"],
+        unit: "degree",
+        below: Some((0.0, "must be in (0, 90) degrees")),
+        above: Some((90.0, "must be in (0, 90) degrees")),
+        typical: Some((10.0, 45.0, "10–45° of AFM cones and pyramids", "angles are in degrees, not radians (25° is 25, not 0.436)")),
+        ..SiRange::NONE
+    },
+    SiRange {
         sections: &["drive"],
         keys: &["free_amplitude"],
         unit: "m",

@@ -187,3 +187,5 @@ pub(super) const WETTING_ANGLE: (&str, fn(f64) -> bool) =
     ("in [0, 90) degrees (a wetting meniscus)", |x| {
         (0.0..90.0).contains(&x)
     });
+/// An indenter's angle (degrees): between the axis and the surface, 0 and 90 excluded.
+pub(super) const ANGLE: (&str, fn(f64) -> bool) = ("in (0, 90) degrees", |x| x > 0.0 && x < 90.0);

@@ -346,7 +346,7 @@ impl Sample {
             }
             _ => None,
         };
-        work.map(|w| {
+        work.filter(|_| self.shape.has_radius()).map(|w| {
             tabor_parameter(
                 si.radius.unwrap_or(0.0),
                 si.e_star.unwrap_or(f64::NAN),
@@ -363,6 +363,7 @@ impl Sample {
         self.si
             .radius
             .filter(|_| hertz.is_ok_and(|k| k.info().tip_radius))
+            .filter(|_| self.shape == crate::contact::indenter::TipShape::Paraboloid)
     }
 
     /// The inputs by their probe keys ([`SampleInputs`]).
@@ -373,13 +374,14 @@ impl Sample {
             poisson_ratio: self.elastic.map(|e| e[1]),
             tip_youngs_modulus: self.elastic.map(|e| e[2]),
             tip_poisson_ratio: self.elastic.map(|e| e[3]),
-            radius: si.radius,
+            radius: si.radius.filter(|_| self.shape.has_radius()),
             adhesion_energy: si.adhesion_energy,
             hamaker: si.hamaker,
             intermolecular_distance: si.a0,
             stiffness: si.stiffness,
             maxwell_stiffness: si.maxwell.map(|m| m.0),
             relaxation_time: si.maxwell.map(|m| m.1),
+            tip_shape: self.shape,
         }
     }
 }

@@ -50,9 +50,34 @@ impl Probe {
         // materials table, crate::units::SILICON_TIP)
         let tip = r.table(root, "tip", false);
         let (mut tip_e, mut tip_nu, mut radius) = (None, None, None);
+        let mut shape = TipShape::Paraboloid;
         if let Some(t) = tip {
-            r.unknown(t, "tip", &["radius", "youngs_modulus", "poisson_ratio"]);
+            r.unknown(
+                t,
+                "tip",
+                &[
+                    "radius",
+                    "youngs_modulus",
+                    "poisson_ratio",
+                    "shape",
+                    "half_angle",
+                    "face_angle",
+                ],
+            );
             radius = r.optional(t, "tip", "radius", "m", POSITIVE);
+            shape = Self::read_shape(&mut r, t);
+            if !shape.has_radius() {
+                if radius.is_some() {
+                    r.warnings.push(format!(
+                        "[tip].radius is not used by the {} shape (the sharp indenter's force \
+                         has no radius)",
+                        shape.name()
+                    ));
+                }
+                // the dimensionless groups' radius, which no analysis that takes this shape
+                // reads (the dynamic ones refuse it: Probe::from_table_for)
+                radius = radius.or(Some(SHAPE_STAND_IN_RADIUS));
+            }
             tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
             tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
             if !t.contains_key("youngs_modulus") {
@@ -65,7 +90,8 @@ impl Probe {
         // [sample]
         let sample = r
             .table(root, "sample", true)
-            .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
+            .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu))
+            .map(|s| Sample { shape, ..s });
         let drive = Self::read_drive(&mut r, root, structure);
         // [medium]
         let medium = r
@@ -109,6 +135,50 @@ impl Probe {
             Err(e) => {
                 r.problems.push(e);
                 None
+            }
+        }
+    }
+
+    /// `[tip] shape` (default the paraboloid) with its angle (degrees): `half_angle` of the
+    /// cone and the four-sided pyramid, `face_angle` of the three-sided one
+    /// ([`TipShape::angle_key`]); an angle of another shape is a problem.
+    fn read_shape(r: &mut Reader<'_>, t: &toml::Table) -> TipShape {
+        const S: &str = "tip";
+        let angles =
+            ["half_angle", "face_angle"].map(|k| (k, r.optional(t, S, k, "degree", ANGLE)));
+        let name = match r.string(t, S, "shape") {
+            None => "paraboloid".to_string(),
+            Some(s) => s.trim().to_ascii_lowercase(),
+        };
+        let key = TipShape::angle_key(&name);
+        let Some(shape) = TipShape::of(&name, f64::NAN) else {
+            r.problems.push(format!(
+                "[tip].shape = '{name}': expected {}",
+                crate::contact::indenter::SHAPES
+            ));
+            return TipShape::Paraboloid;
+        };
+        for (k, _) in angles {
+            if t.contains_key(k) && key != Some(k) {
+                r.problems.push(format!(
+                    "[tip].{k}: the {name} shape takes {}",
+                    key.map_or("[tip].radius (m)".to_string(), |a| format!(
+                        "[tip].{a} (degrees)"
+                    ))
+                ));
+            }
+        }
+        match key {
+            None => shape,
+            Some(k) if !t.contains_key(k) => {
+                r.problems.push(format!(
+                    "missing key [tip].{k} (degrees, needed by the {name} shape)"
+                ));
+                shape
+            }
+            Some(k) => {
+                let angle = angles.iter().find(|(a, _)| *a == k).and_then(|(_, v)| *v);
+                TipShape::of(&name, angle.unwrap_or(f64::NAN)).unwrap_or(shape)
             }
         }
     }
@@ -586,6 +656,7 @@ impl Probe {
             },
             z_c,
             elastic: None,
+            shape: TipShape::Paraboloid,
         };
         let si = &mut out.si;
         match out.law.as_str() {

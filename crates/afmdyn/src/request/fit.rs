@@ -12,8 +12,11 @@ use super::run::{Request, Resolved};
 use crate::analysis::fit::force_curve::{self, Segment, CONTACT_POINT, YOUNGS_MODULUS};
 use crate::analysis::fit::profile::MAX_GRID_REFITS;
 use crate::analysis::fit::sls_curve;
+use crate::contact::indenter::bottom_effect::BottomEffect;
+use crate::contact::indenter::Indenter;
 use crate::contact::LawKind;
 use crate::error::SimError;
+use crate::probe::SampleInputs;
 use serde::{Deserialize, Serialize};
 
 /// The most rows a force curve may have (a 1 MHz record of one second).
@@ -95,6 +98,17 @@ pub struct FitRequest {
     /// side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each
     /// started from its neighbour; a side that has not risen by then is reported flat).
     pub profiles: Option<bool>,
+    /// The sample's thickness h (m, > 0) above a rigid substrate: the Hertz law's force is
+    /// corrected for the bottom effect (Dimitriadis et al., *Biophys. J.* 82 (2002) 2798 for
+    /// the paraboloid and the sphere; Garcia & Garcia, *Biophys. J.* 114 (2018) 2923 for the
+    /// cone, the pyramids and the flat punch, an incompressible sample, ν 0.45–0.5). Default
+    /// none: a sample infinitely thick.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+    pub thickness: Option<f64>,
+    /// Whether the sample is bonded to the substrate (glued; the default, true) or free to
+    /// slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the
+    /// sphere only). Used with `thickness`.
+    pub bonded: Option<bool>,
 }
 
 impl Default for FitRequest {
@@ -110,6 +124,8 @@ impl Default for FitRequest {
             range: None,
             approach_rows: None,
             profiles: None,
+            thickness: None,
+            bonded: None,
         }
     }
 }
@@ -230,10 +246,56 @@ impl FitRequest {
         }
     }
 
+    /// The tip's shape of the probe's `[tip]` and the bottom-effect correction of `thickness`
+    /// (and `bonded`) for the sample `s` ([`crate::contact::indenter`]).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `thickness`, `bonded` or `sample.poisson_ratio`
+    /// ([`BottomEffect::new`]), or `bonded` given without `thickness`.
+    pub(crate) fn indenter(&self, s: &SampleInputs) -> Result<Indenter, SimError> {
+        let shape = s.tip_shape;
+        let bottom = match (self.thickness, self.bonded) {
+            (None, Some(b)) => {
+                return Err(bad(
+                    "bonded",
+                    b,
+                    "bonded is the bottom-effect correction's: give the sample's thickness (m)"
+                        .into(),
+                ))
+            }
+            (None, None) => None,
+            (Some(h), bonded) => {
+                let nu = s.poisson_ratio.unwrap_or(f64::NAN);
+                Some(BottomEffect::new(shape, h, bonded.unwrap_or(true), nu)?)
+            }
+        };
+        Ok(Indenter { shape, bottom })
+    }
+
     /// Check the options against the probe's law (the data are checked when read).
     pub(crate) fn check(&self, model: &Resolved) -> Result<LawKind, SimError> {
         let law = Self::law(model)?;
-        let names = force_curve::parameter_names(law).unwrap_or_default();
+        let inputs = model
+            .probe
+            .as_ref()
+            .map(|p| p.sample_inputs)
+            .unwrap_or_default();
+        inputs.tip_shape.check_law(law)?;
+        if self.thickness.is_some() && law != LawKind::Hertz {
+            return Err(bad(
+                "thickness",
+                crate::error::number(self.thickness.unwrap_or(f64::NAN)),
+                format!(
+                    "the bottom-effect correction is the hertz law's elastic force's; the {} \
+                     law takes none",
+                    law.name()
+                ),
+            ));
+        }
+        if law == LawKind::Hertz {
+            self.indenter(&inputs)?;
+        }
+        let names = force_curve::parameter_names_of(law, &inputs.tip_shape).unwrap_or_default();
         if law == LawKind::Jkr && self.segment == Some(FitSegment::Whole) {
             return Err(bad(
                 "segment",
@@ -359,6 +421,19 @@ impl Request for FitRequest {
             // for a force curve (its stand-ins) is refused now
             if let Some(p) = model.probe.as_ref().filter(|p| !p.assumed.is_empty()) {
                 super::fit_dynamic::am_probe(p)?;
+            }
+            if let Some((name, value)) = self
+                .thickness
+                .map(|h| ("thickness", crate::error::number(h)))
+                .or(self.bonded.map(|b| ("bonded", b.to_string())))
+            {
+                return Err(bad(
+                    name,
+                    value,
+                    "the bottom-effect correction is the force-curve fit's; a dynamic curve's \
+                     sample is a half space"
+                        .into(),
+                ));
             }
             return self.check_range();
         }

@@ -191,6 +191,15 @@ pub(crate) fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError>
         ));
     }
     let s = probe.sample_inputs;
+    if s.tip_shape != crate::contact::indenter::TipShape::Paraboloid {
+        return Err(SimError::out_of_range(
+            "tip.shape",
+            s.tip_shape.name(),
+            "an AM, FM or bimodal curve is fitted with the oscillating lever's model, whose \
+             contact laws take the paraboloid (shape = \"paraboloid\", the default); the other \
+             shapes are the force-curve fit's",
+        ));
+    }
     Ok(AmProbe {
         params: probe.params,
         length_m: probe.scales.length_m,

@@ -250,7 +250,7 @@ impl FitRequest {
         let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
         let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
         let sig: Option<Vec<f64>> = c.sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
-        let names = force_curve::parameter_names(law)
+        let names = force_curve::parameter_names_of(law, &s.tip_shape)
             .unwrap_or_default()
             .to_vec();
         let mut params = start_values(&names, s, &x, &y)?;
@@ -285,6 +285,7 @@ impl FitRequest {
                     probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
                 ),
                 intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+                indenter: self.indenter(s)?,
             }),
         };
         let m: &dyn CurveModel = match (&sls, &elastic) {
@@ -470,9 +471,20 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
          & Solares 2014), driven through the lever in series from the piezo height (x − F/k, free \
          of the force noise; linear between rows), from rest at the first row"
     } else {
-        "F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R \
-         δ^{3/2}, Sneddon 1965)"
+        "F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: E* g(δ) of \
+         the probe's [tip] shape, the paraboloid's (4/3)√R δ^{3/2} by default, Sneddon 1965; \
+         contact::indenter)"
     };
+    let model =
+        match request.thickness {
+            Some(h) => format!(
+            "{model}, times the bottom-effect factor of a {} sample {} m thick (Dimitriadis et \
+             al. 2002 for the paraboloid and sphere, Garcia & Garcia 2018 for the others)",
+            if request.bonded == Some(false) { "non-bonded" } else { "bonded" },
+            crate::error::number(h)
+        ),
+            None => model.to_string(),
+        };
     let mut doc = json!({
         "estimates": estimates,
         "parameters": parameters,
@@ -507,7 +519,7 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
                   "sample.maxwell_stiffness": "N/m", "sample.relaxation_time": "s", "time": "s",
                   "tip_position": "m", "force": "N",
                   "fit": "N", "residual": "N", "chi2_dof": if o.noise_estimated { "N^2" } else { "1" }},
-        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); ".to_string() + model + "; standard errors from (JᵀWJ)⁻¹ s²; " + intervals_method(o) + " (docs/tutorials/fitting-force-curves.md)",
+        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); ".to_string() + &model + "; standard errors from (JᵀWJ)⁻¹ s²; " + intervals_method(o) + " (docs/tutorials/fitting-force-curves.md)",
         "warnings": o.warnings,
     });
     if let Some(t) = &r.curve.time {

@@ -28,11 +28,21 @@
 //! holds down to the break on the retract). Each law's groups are homogeneous in their units,
 //! so the law's dimensionless force is the SI force with g₀ = 1 m and F̃ = 1 N.
 //!
+//! # Indenter shapes and finite thickness
+//! Under the Hertz law the tip's shape (`[tip] shape`, [`crate::contact::indenter`]) gives
+//! F_c = E* g(δ) c(δ): g the shape's force per unit E* (the paraboloid's (4/3)√R δ^{3/2},
+//! Sneddon's exact sphere, cone, the pyramids, the flat punch) and c the bottom-effect factor
+//! of a sample of the request's `thickness` (1 without; Dimitriadis et al. 2002, Garcia &
+//! Garcia 2018: [`crate::contact::indenter::bottom_effect`]). A shape without a radius has no
+//! `tip.radius` parameter; its angle is held. ∂F/∂E_s = g c ∂E*/∂E_s, ∂F/∂R and ∂F/∂δ are the
+//! shape's and the factor's exact derivatives.
+//!
 //! # Sensitivities
 //! ∂F/∂contact_point is the law's exact ∂F_c/∂δ; ∂F/∂baseline = 1; through the groups,
 //! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
+use crate::contact::indenter::{Indenter, TipShape};
 use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law, LawKind};
 
 /// The names of the force-curve model's parameters of the registry's law `law`, in the
@@ -54,6 +64,19 @@ pub(crate) fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
             BASELINE,
         ]),
         _ => None,
+    }
+}
+
+/// The names of the force-curve model's parameters of the law `law` with a tip of `shape`:
+/// [`parameter_names`], less `tip.radius` for a shape without a radius (a cone, a pyramid) under
+/// the Hertz law; `None` for a law the fit does not take.
+pub(crate) fn parameter_names_of(
+    law: LawKind,
+    shape: &TipShape,
+) -> Option<&'static [&'static str]> {
+    match law {
+        LawKind::Hertz if !shape.has_radius() => Some(&[YOUNGS_MODULUS, CONTACT_POINT, BASELINE]),
+        _ => parameter_names(law),
     }
 }
 
@@ -191,6 +214,9 @@ pub(crate) struct ForceCurveModel {
     pub tip: (f64, f64),
     /// DMT's intermolecular distance a₀ (m; held).
     pub intermolecular_distance: f64,
+    /// The tip's shape and the sample's bottom-effect correction (the Hertz law's; the
+    /// paraboloid of infinite thickness under the other laws).
+    pub indenter: Indenter,
 }
 
 impl ForceCurveModel {
@@ -230,11 +256,50 @@ impl ForceCurveModel {
     }
 }
 
+impl ForceCurveModel {
+    /// The Hertz law's F = baseline + E* g(δ) c(δ) of the tip's shape (module docs), with the
+    /// parameters of [`parameter_names_of`]: E_s, R (a shape with a radius), contact point and
+    /// baseline.
+    fn evaluate_shape(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        let radius = self.indenter.shape.has_radius();
+        let (e_s, [r, cp, baseline]) = match radius {
+            true => (p[0], [p[1], p[2], p[3]]),
+            false => (p[0], [f64::NAN, p[1], p[2]]),
+        };
+        let b = 1.0 - self.poisson_ratio * self.poisson_ratio;
+        let e_star = reduced_modulus(self.tip.0, self.tip.1, e_s, self.poisson_ratio);
+        // ∂E*/∂E_s = E*² (1 − ν_s²)/E_s²
+        let de_star = e_star * e_star * b / (e_s * e_s);
+        let n = p.len();
+        let mut jac = jacobian;
+        for (i, x) in self.x.iter().enumerate() {
+            let g = self.indenter.elastic(r, cp - x);
+            values[i] = baseline + e_star * g.force;
+            let Some(j) = jac.as_deref_mut() else {
+                continue;
+            };
+            let row = &mut j[i * n..(i + 1) * n];
+            row[0] = g.force * de_star;
+            let at = if radius {
+                row[1] = e_star * g.d_radius;
+                2
+            } else {
+                1
+            };
+            row[at] = e_star * g.d_delta;
+            row[at + 1] = 1.0;
+        }
+    }
+}
+
 impl super::CurveModel for ForceCurveModel {
     fn points(&self) -> usize {
         self.x.len()
     }
     fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        if self.law == LawKind::Hertz {
+            return self.evaluate_shape(p, values, jacobian);
+        }
         let (e_s, r, cp, baseline) = (p[0], p[1], p[2], p[3]);
         let (k, dk_de) = self.hertz_group(e_s, r);
         // the law's second group and its derivatives by R and by its own parameter
