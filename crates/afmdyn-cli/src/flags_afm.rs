@@ -190,6 +190,18 @@ pub struct FitMapFlags {
     /// `--threads`: the request's `threads`.
     #[arg(long, help = "Worker threads (default: all cores); the results do not depend on it.")]
     pub threads: Option<usize>,
+    /// `--bonded`: the request's `bonded`.
+    #[arg(long, conflicts_with = "no_bonded", help = "Whether the sample is bonded to the substrate (the default, true) or free to slide on it (false: the paraboloid's and the sphere's non-bonded series only), with --thickness or --substrate-height.")]
+    pub bonded: bool,
+    /// `--no-bonded`: the request's `bonded` false.
+    #[arg(long, help = "Turns --bonded off (not given: the default).")]
+    pub no_bonded: bool,
+    /// `--substrate-height`: the request's `substrate_height`.
+    #[arg(long, allow_hyphen_values = true, help = "The substrate's piezo height (m, the height column's frame), read, for instance, on a bare-glass pixel of the map's topography: each curve's thickness is its fitted contact point's height above it (the curve refitted until its thickness moves by less than 1e-4 of itself, from the contact point the deviation from the baseline finds). A curve whose contact is not above it fails, naming it. Not with --thickness. With --probe a unit may follow (20nm).")]
+    pub substrate_height: Option<Quantity>,
+    /// `--thickness`: the request's `thickness`.
+    #[arg(long, allow_hyphen_values = true, help = "The sample's thickness h (m, > 0) above a rigid substrate, one value for every curve: the Hertz law's force corrected for the bottom effect as --fit's --thickness (Dimitriadis et al. 2002; Garcia & Garcia 2018). Default none: a sample infinitely thick. Not with --substrate-height. With --probe a unit may follow (20nm).")]
+    pub thickness: Option<Quantity>,
 }
 
 impl FitMapFlags {
@@ -199,10 +211,13 @@ impl FitMapFlags {
     /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`), or a list of another length than its field's.
     pub fn request(&self, si: bool) -> Result<FitMapRequest, CliError> {
         Ok(FitMapRequest {
+            bonded: either(self.bonded, self.no_bonded),
             data: self.data.clone(),
             fit: self.fit.clone(),
             range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
             segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
+            substrate_height: quantity(self.substrate_height, "substrate-height", Dim::Length, si)?,
+            thickness: quantity(self.thickness, "thickness", Dim::Length, si)?,
             threads: self.threads,
         })
     }

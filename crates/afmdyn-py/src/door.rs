@@ -88,7 +88,7 @@ pub fn run_stored(
     resume: bool,
 ) -> PyResult<Py<PyDict>> {
     let stored = crate::convert::stored(name, request)?;
-    let model = resolved(params, probe, ProbeNeeds::Oscillation)?;
+    let model = resolved(params, probe, stored.probe_needs())?;
     let study = stored.prepare(model).map_err(sim_error)?;
     if resume && store.is_none() {
         let msg = "resume=True needs store= (the directory of the interrupted run)";

@@ -45,9 +45,30 @@ fn surface(ix: usize, iy: usize) -> f64 {
     50e-9 * ix as f64 + 20e-9 * iy as f64
 }
 
+/// Dimitriadis et al.'s bottom-effect factor of a paraboloid on a layer `h` thick bonded to
+/// its substrate at ν = 0.5 (*Biophys. J.* 82 (2002) 2798, eq. 11 with its α₀ and β₀; written
+/// here for the test) at the indentation `d`.
+fn dimitriadis_bonded(d: f64, h: f64) -> f64 {
+    let pi = std::f64::consts::PI;
+    let a0 = -(1.2876 - 1.4678 * NU + 1.3442 * NU * NU) / (1.0 - NU);
+    let b0 = (0.6387 - 1.0277 * NU + 1.5164 * NU * NU) / (1.0 - NU);
+    let x = (R * d).sqrt() / h;
+    1.0 - 2.0 * a0 / pi * x + 4.0 * a0 * a0 / (pi * pi) * x * x
+        - 8.0 / pi.powi(3) * (a0.powi(3) + 4.0 * pi * pi / 15.0 * b0) * x.powi(3)
+        + 16.0 * a0 / pi.powi(4) * (a0.powi(3) + 3.0 * pi * pi / 5.0 * b0) * x.powi(4)
+}
+
 /// One approach at (ix, iy) as CSV lines: tip positions from 1 µm above the surface to 1.5 µm
-/// below; the last curve of the first line `flat` (never reaching the sample).
-fn curve(text: &mut String, ix: usize, iy: usize, rng: &mut ChaCha8Rng, flat: bool) {
+/// below; the last curve of the first line `flat` (never reaching the sample); on a layer
+/// bonded to a substrate at the piezo height `substrate` when given.
+fn layer_curve(
+    text: &mut String,
+    ix: usize,
+    iy: usize,
+    rng: &mut ChaCha8Rng,
+    flat: bool,
+    substrate: Option<f64>,
+) {
     let e_star = 1.0
         / ((1.0 - 0.27 * 0.27) / afmdyn::cantilevers::SILICON_YOUNGS_MODULUS
             + (1.0 - NU * NU) / modulus(ix, iy));
@@ -57,7 +78,9 @@ fn curve(text: &mut String, ix: usize, iy: usize, rng: &mut ChaCha8Rng, flat: bo
     for i in 0..ROWS {
         let depth = if flat { 0.5e-6 } else { 2.5e-6 };
         let x = cp + 1e-6 - depth * i as f64 / (ROWS - 1) as f64;
-        let f = kh * (cp - x).max(0.0).powf(1.5);
+        let d = (cp - x).max(0.0);
+        let c = substrate.map_or(1.0, |z| dimitriadis_bonded(d, cp - z));
+        let f = kh * d.powf(1.5) * c;
         let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
         let noise = SIGMA * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
         writeln!(text, "{x0:e},{y0:e},{:e},{:e}", x - f / K, f + noise).unwrap();
@@ -66,13 +89,20 @@ fn curve(text: &mut String, ix: usize, iy: usize, rng: &mut ChaCha8Rng, flat: bo
 
 /// The synthetic map written to a fresh directory: its CSV's path.
 fn map(name: &str) -> std::path::PathBuf {
+    layer_map(name, None)
+}
+
+/// The synthetic map, on a layer bonded to a substrate at the piezo height `substrate` when
+/// given.
+fn layer_map(name: &str, substrate: Option<f64>) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("afmdyn-fit-map-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(78);
     let mut text = String::from("x,y,height,force\n");
     for iy in 0..N {
         for ix in 0..N {
-            curve(&mut text, ix, iy, &mut rng, iy == 0 && ix == N - 1);
+            let flat = iy == 0 && ix == N - 1;
+            layer_curve(&mut text, ix, iy, &mut rng, flat, substrate);
         }
     }
     let path = dir.join("map.csv");
@@ -248,4 +278,70 @@ fn a_map_fitted_with_another_levers_probe_says_its_data_look_off() {
     };
     assert!(says(&other));
     assert!(!says(&probe()));
+}
+
+/// A cell-like layer on glass: the map's curves indent a layer bonded to a substrate 4 µm
+/// below the surface (χ = √(Rδ)/h up to 0.7), fitted with `substrate_height`: each curve's
+/// thickness is its topography above it (within 10 nm of the layer written), every E is recovered within its
+/// interval at the stated coverage, and the same map fitted as infinitely thick reads a
+/// stiffer sample; `thickness` with `substrate_height`, or a substrate above the sample, is
+/// refused naming `substrate_height`.
+#[test]
+fn a_thin_layer_is_fitted_with_its_thickness_from_the_topography() {
+    let z = -4e-6;
+    let path = layer_map("layer", Some(z));
+    let with = FitMapRequest {
+        substrate_height: Some(z),
+        ..request(&path, 2)
+    };
+    let m = run(&with, &probe(), &Progress::default())
+        .expect("fit-map")
+        .output;
+    let thick = fitted(&path, 2);
+    let (mut inside, mut fits, mut stiffer) = (0, 0, 0);
+    for (c, t) in m.curves.iter().zip(&thick.curves) {
+        if c.flag != CurveFlag::Fitted {
+            continue;
+        }
+        let h = c.thickness.expect("thickness");
+        // the fitted topography above the substrate (to the refits' tolerance), within 10 nm of the layer written (the soft inclusion's contact point is
+        // the least constrained)
+        let want = surface(c.ix, c.iy) - z;
+        assert!(
+            (h - want).abs() < 10e-9,
+            "({}, {}): {h} vs {want}",
+            c.ix,
+            c.iy
+        );
+        let topography = c.contact_height.unwrap() - z;
+        assert!((h - topography).abs() < 1e-4 * h, "{h} vs {topography}");
+        let truth = modulus(c.ix, c.iy);
+        let [lo, hi] = c.intervals[0];
+        inside += usize::from(lo.unwrap() <= truth && truth <= hi.unwrap());
+        fits += 1;
+        stiffer += usize::from(t.values[0].unwrap() > 1.3 * truth);
+    }
+    assert!(inside >= 54 && fits == N * N - 1, "{inside} of {fits}");
+    assert_eq!(stiffer, fits);
+    let doc = afmdyn::report::fit_map::document(&m);
+    assert!(doc["preprocessing"]["bottom_effect"]
+        .as_str()
+        .unwrap()
+        .contains("above the substrate"));
+    let refused = |r: FitMapRequest| match run(&r, &probe(), &Progress::default()) {
+        Err(afmdyn::SimError::OutOfRange { name, .. }) => name,
+        Err(e) => panic!("{e}"),
+        Ok(_) => panic!("accepted"),
+    };
+    let both = FitMapRequest {
+        thickness: Some(1e-6),
+        ..with.clone()
+    };
+    assert_eq!(refused(both), "substrate_height");
+    let above = FitMapRequest {
+        substrate_height: Some(3e-6),
+        ..with
+    };
+    let e = run(&above, &probe(), &Progress::default()).err().unwrap();
+    assert!(e.to_string().contains("substrate_height"), "{e}");
 }

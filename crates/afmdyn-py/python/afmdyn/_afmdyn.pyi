@@ -451,10 +451,13 @@ FitRequest = TypedDict(
 FitMapRequest = TypedDict(
     "FitMapRequest",
     {
+        "bonded": Optional[bool],  # default null
         "data": Optional[str],  # default null
         "fit": List[str],  # default ["sample.youngs_modulus", "contact_point", "baseline"]
         "range": Optional[List[float]],  # default null
         "segment": Optional[Literal["approach", "retract", "whole"]],  # default null
+        "substrate_height": Optional[float],  # default null
+        "thickness": Optional[float],  # default null
         "threads": Optional[int],  # default null
     },
     total=False,

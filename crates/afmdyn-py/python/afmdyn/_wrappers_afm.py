@@ -854,15 +854,18 @@ def fit(
     return _fit._finish_fit(locals())
 
 
-@_typed(si={"fit_range": "length"})
+@_typed(si={"fit_range": "length", "substrate_height": "length", "thickness": "length"})
 def fit_map(
     params: Optional[Params] = None,
     /,
     *,
+    bonded: Optional[bool] = None,
     data: Union[str, "os.PathLike[str]", Sequence[Any], None] = None,
     fit: Optional[Sequence[str]] = None,
     fit_range: Optional[Tuple[float, float]] = None,
     segment: Optional[str] = None,
+    substrate_height: Optional[float] = None,
+    thickness: Optional[float] = None,
     threads: Optional[int] = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
@@ -876,6 +879,9 @@ def fit_map(
     is required; a curve's own spring constant (an instrument file's) replaces the probe's.
 
     Args:
+        bonded: Whether the sample is bonded to the substrate (the default, true) or free to
+            slide on it (false: the paraboloid's and the sphere's non-bonded series only),
+            with ``thickness`` or ``substrate_height``.
         data: the map: an instrument file afmformats reads (JPK ``.jpk-force-map``, ``.jpk-
             qi-data``, …; each curve's grid index, position and spring constant from its
             metadata), a list of afmformats curves or of mappings (``x``, ``y``, ``height``,
@@ -892,6 +898,16 @@ def fit_map(
             contact point found by the deviation from the baseline, as nanite's
             ``range_x``); default the whole segment.
         segment: The segment fitted: ``approach`` (the default), ``retract`` or ``whole``.
+        substrate_height: The substrate's piezo height (m, the ``height`` column's frame),
+            read, for instance, on a bare-glass pixel of the map's topography: each curve's
+            thickness is its fitted contact point's height above it (the curve refitted
+            until its thickness moves by less than 1e-4 of itself, from the contact point
+            the deviation from the baseline finds). A curve whose contact is not above it
+            fails, naming it. Not with ``thickness``.
+        thickness: The sample's thickness h (m, > 0) above a rigid substrate, one value for
+            every curve: the Hertz law's force corrected for the bottom effect as ``fit``'s
+            ``thickness`` (Dimitriadis et al. 2002; Garcia & Garcia 2018). Default none: a
+            sample infinitely thick. Not with ``substrate_height``.
         threads: Worker threads (default: all cores); the results do not depend on it.
         store: a directory for the command line's resumable store (``afmdyn fit_map --out
             DIR``; created if needed, started over without ``resume``).

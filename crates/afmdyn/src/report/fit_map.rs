@@ -32,9 +32,10 @@ pub fn unit_of(key: &str) -> &'static str {
 /// per parameter its `median` and 16th–84th percentiles over the curves flagged `fitted`
 /// (`summary`),
 /// `curves` (each curve's `x`, `y`, `ix`, `iy`, `estimates` keyed as `fit`'s with `value`,
-/// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag` and
-/// `reason`), `units`, `preprocessing` (nanite's steps, how the contact point is found, the
-/// segment and `range_x`), `method` and `warnings`.
+/// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag`,
+/// `reason`, and `thickness` where the bottom effect is corrected), `units`, `preprocessing`
+/// (nanite's steps, how the contact point is found, the segment, `range_x` and
+/// `bottom_effect`: how the sample's thickness was given), `method` and `warnings`.
 pub fn document(m: &FitMap) -> Value {
     let counts: serde_json::Map<String, Value> = (m.counts().into_iter())
         .map(|(name, n)| (name.to_string(), json!(n)))
@@ -62,6 +63,7 @@ pub fn document(m: &FitMap) -> Value {
     }
     units.insert("x".into(), json!("m"));
     units.insert("contact_height".into(), json!("m"));
+    units.insert("thickness".into(), json!("m"));
     units.insert("chi2_dof".into(), json!("N^2"));
     json!({
         "law": m.law.name(),
@@ -82,6 +84,7 @@ pub fn document(m: &FitMap) -> Value {
             "segment": m.segment,
             "range_x": m.range,
             "range_type": "relative to deviation_from_baseline's contact point (tip positions after correct_tip_offset)",
+            "bottom_effect": m.layer,
         },
         "method": "every curve fitted as fit fits one (nanite's preprocessing; Levenberg–Marquardt; \
                    no σ: the noise estimated from the residuals), its intervals Wald's (±1.96 \
@@ -107,6 +110,7 @@ fn curve_entry(m: &FitMap, c: &CurveFit) -> Value {
         "chi2_dof": c.chi2_dof,
         "contact_rows": c.contact_rows,
         "contact_height": c.contact_height,
+        "thickness": c.thickness,
         "flag": c.flag,
         "reason": c.reason,
     })
@@ -156,7 +160,7 @@ fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> 
 /// The map's layout over (y, x): the coordinates `x`, `y` (m); per fitted parameter its
 /// value, `_standard_error`, `_lower` and `_upper` (the 95 % interval) named by
 /// [`short_name`]; `chi2_dof` (N²), `contact_rows`, `topography` (the contact point's
-/// piezo height, m) and `flag` (CF `flag_values`/`flag_meanings`: [`CurveFlag::NAMES`]).
+/// piezo height, m), `thickness` (m, where the bottom effect is corrected) and `flag` (CF `flag_values`/`flag_meanings`: [`CurveFlag::NAMES`]).
 pub fn layout(m: &FitMap) -> Layout {
     let (nx, ny) = (m.xs.len(), m.ys.len());
     let at = |c: &CurveFit| c.iy * nx + c.ix;
@@ -233,6 +237,15 @@ pub fn layout(m: &FitMap) -> Layout {
         "the contact point's piezo height",
         &grid(&|c| c.contact_height),
     ));
+    if m.layer.is_some() {
+        vars.push(Variable::f64(
+            "thickness",
+            d,
+            "m",
+            "the sample's thickness of the bottom-effect correction",
+            &grid(&|c| c.thickness),
+        ));
+    }
     vars.push(
         Variable::i32("flag", d, "1", "how the curve's fit ended", &flags)
             .with("flag_values", Attr::I32((0..6).collect()))

@@ -38,6 +38,23 @@ pub struct FitMapRequest {
     /// segment.
     #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub range: Option<[f64; 2]>,
+    /// The sample's thickness h (m, > 0) above a rigid substrate, one value for every curve:
+    /// the Hertz law's force corrected for the bottom effect as `fit`'s `thickness`
+    /// (Dimitriadis et al. 2002; Garcia & Garcia 2018). Default none: a sample infinitely
+    /// thick. Not with `substrate_height`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+    pub thickness: Option<f64>,
+    /// The substrate's piezo height (m, the `height` column's frame), read, for instance, on
+    /// a bare-glass pixel of the map's topography: each curve's thickness is its fitted
+    /// contact point's height above it (the curve refitted until its thickness moves by less
+    /// than 1e-4 of itself, from the contact point the deviation from the baseline finds). A
+    /// curve whose contact is not above it fails, naming it. Not with `thickness`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+    pub substrate_height: Option<f64>,
+    /// Whether the sample is bonded to the substrate (the default, true) or free to slide on
+    /// it (false: the paraboloid's and the sphere's non-bonded series only), with
+    /// `thickness` or `substrate_height`.
+    pub bonded: Option<bool>,
     /// Worker threads (default: all cores); the results do not depend on it.
     pub threads: Option<usize>,
 }
@@ -49,6 +66,9 @@ impl Default for FitMapRequest {
             fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into(), BASELINE.into()],
             segment: None,
             range: None,
+            thickness: None,
+            substrate_height: None,
+            bonded: None,
             threads: None,
         }
     }
@@ -79,7 +99,9 @@ impl FitMapRequest {
     }
 
     /// The request each curve is fitted with: `fit`'s options, its profiles off (each
-    /// estimate's interval is Wald's, ±1.96 standard errors).
+    /// estimate's interval is Wald's, ±1.96 standard errors), the sample's `thickness` (with
+    /// `substrate_height`, each curve's is set when it is fitted; here 1 m, so that the
+    /// shape, `bonded` and the law are checked as with a thickness).
     pub(crate) fn curve_request(&self) -> FitRequest {
         FitRequest {
             data: self.data.clone(),
@@ -87,7 +109,26 @@ impl FitMapRequest {
             segment: self.segment,
             range: self.range,
             profiles: Some(false),
+            thickness: self.thickness.or(self.substrate_height.map(|_| 1.0)),
+            bonded: self.bonded,
             ..FitRequest::default()
+        }
+    }
+
+    /// Check `thickness` against `substrate_height`.
+    fn check_layer(&self) -> Result<(), SimError> {
+        match (self.thickness, self.substrate_height) {
+            (Some(_), Some(z)) => Err(bad(
+                "substrate_height",
+                crate::error::number(z),
+                "give the sample's thickness or the substrate's height, not both".into(),
+            )),
+            (_, Some(z)) if !z.is_finite() => Err(bad(
+                "substrate_height",
+                crate::error::number(z),
+                "the substrate's piezo height must be finite (m)".into(),
+            )),
+            _ => Ok(()),
         }
     }
 
@@ -107,6 +148,7 @@ impl Request for FitMapRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.path()?;
         super::limits::check_threads(self.threads)?;
+        self.check_layer()?;
         self.curve_request().check(model).map(|_| ())
     }
     fn name(&self) -> &'static str {

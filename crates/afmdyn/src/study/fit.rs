@@ -208,6 +208,7 @@ fn contact_point_warning(tip: &[f64], contact: f64) -> Option<String> {
 /// One measured force curve: its piezo heights (m), forces (N), their σ (N) and the rows'
 /// times (s), the lever's spring constant (N/m) and, where the instrument records its
 /// segments, the number of approach rows.
+#[derive(Clone)]
 pub(crate) struct Curve<'a> {
     /// The piezo heights (m).
     pub height: &'a [f64],

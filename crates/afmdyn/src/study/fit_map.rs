@@ -46,6 +46,11 @@ pub(crate) fn fit_map_store(lock: &DirLock) -> TaskStore<'_, Lines<Vec<CurveFit>
     TaskStore::new(lock, Lines::of(FIT_MAP_FILES))
 }
 
+/// The refits of a curve whose thickness is its contact point's height above the substrate,
+/// at most, and the relative move of the thickness they stop at.
+const LAYER_STEPS: usize = 8;
+const LAYER_TOLERANCE: f64 = 1e-4;
+
 /// The curves shown with their fits: at most this many, spread over the map.
 const SHOWN_CURVES: usize = 4;
 
@@ -58,6 +63,10 @@ pub struct MapStudy {
     sample: SampleInputs,
     spring_constant: f64,
     names: Vec<String>,
+    /// The substrate's piezo height each curve's thickness is measured from (m).
+    substrate_height: Option<f64>,
+    /// How the thickness was given, for the document.
+    layer: Option<String>,
     shown: Vec<usize>,
     fingerprint: Value,
 }
@@ -80,6 +89,8 @@ impl MapStudy {
         Ok(MapStudy {
             names: curve_request.fitted(law),
             request: curve_request,
+            substrate_height: request.substrate_height,
+            layer: layer_of(request),
             law,
             sample: probe.sample_inputs,
             spring_constant: probe.calibration.spring_constant,
@@ -150,11 +161,7 @@ impl MapStudy {
             spring_constant: k,
             approach_rows: c.approach_rows,
         };
-        let never = Progress::new();
-        let r = match self
-            .request
-            .fit_curve(self.law, &self.sample, curve, None, &never)
-        {
+        let (r, thickness) = match self.fit_layer(curve) {
             Ok(r) => r,
             Err(e) => return failed(c, self.names.len(), e.to_string()),
         };
@@ -164,7 +171,7 @@ impl MapStudy {
         let cp = value(CONTACT_POINT);
         let x: Vec<f64> = r.rows.iter().map(|&i| r.curve.tip_position[i]).collect();
         let contact_rows = x.iter().filter(|&&x| x < cp).count();
-        let contact_height = cp + r.curve.tip_offset - (r.curve.force_offset + value(BASELINE)) / k;
+        let contact_height = contact_height_of(&r, k);
         let finite = |v: f64| v.is_finite().then_some(v);
         let (flag, reason) = flag_of(&r, contact_rows, value(BASELINE));
         let shown = show.then(|| {
@@ -192,6 +199,7 @@ impl MapStudy {
             chi2_dof: finite(o.chi2_dof),
             contact_rows,
             contact_height: finite(contact_height),
+            thickness,
             flag,
             reason,
             data_warning: super::fit::data_warnings(&rows.height, &rows.force, k)
@@ -199,6 +207,46 @@ impl MapStudy {
                 .next(),
             shown,
         }
+    }
+
+    /// The fit of `curve` and the sample's thickness it was fitted with: the request's, or,
+    /// with a substrate height, the fitted contact point's height above it — fitted first
+    /// with the thickness under the contact point by the deviation from the baseline (nanite's
+    /// preprocessing), then again with the thickness under the contact point the last fit
+    /// found, until the thickness moves by at most [`LAYER_TOLERANCE`] of itself (at most
+    /// [`LAYER_STEPS`] refits: the contact moves by nm where the thickness is µm).
+    ///
+    /// # Errors
+    /// `fit`'s, and [`SimError::OutOfRange`] naming `substrate_height` for a contact not
+    /// above the substrate.
+    fn fit_layer(
+        &self,
+        curve: Curve<'_>,
+    ) -> Result<(super::fit_result::FitResult, Option<f64>), SimError> {
+        let never = Progress::new();
+        let (law, s) = (self.law, &self.sample);
+        let Some(z) = self.substrate_height else {
+            let r = self.request.fit_curve(law, s, curve, None, &never)?;
+            return Ok((r, self.request.thickness));
+        };
+        let k = curve.spring_constant;
+        let at = |h: f64| FitRequest {
+            thickness: Some(h),
+            ..self.request.clone()
+        };
+        let first = crate::analysis::fit::force_curve::preprocess(curve.height, curve.force, k);
+        // the contact's piezo height: tip position 0 after correct_tip_offset, force 0
+        let mut h = thickness_above(z, first.tip_offset - first.force_offset / k)?;
+        let mut r = at(h).fit_curve(law, s, curve.clone(), None, &never)?;
+        for _ in 0..LAYER_STEPS {
+            let next = thickness_above(z, contact_height_of(&r, k))?;
+            if (next - h).abs() <= LAYER_TOLERANCE * h {
+                break;
+            }
+            h = next;
+            r = at(h).fit_curve(law, s, curve.clone(), None, &never)?;
+        }
+        Ok((r, Some(h)))
     }
 
     /// The fitted map of the tasks' `records` (any order).
@@ -222,8 +270,58 @@ impl MapStudy {
                 Segment::Whole => "whole",
             },
             range: self.request.range,
+            layer: self.layer.clone(),
         })
     }
+}
+
+/// How `request` gives the sample's thickness, for the document (`None`: infinitely thick).
+fn layer_of(request: &FitMapRequest) -> Option<String> {
+    let bonded = match request.bonded {
+        Some(false) => "non-bonded",
+        _ => "bonded",
+    };
+    let n = crate::error::number;
+    match (request.thickness, request.substrate_height) {
+        (Some(h), _) => Some(format!("{bonded}, {} m thick at every curve", n(h))),
+        (None, Some(z)) => Some(format!(
+            "{bonded}, each curve's thickness its fitted contact point's height above the \
+             substrate's height {} m (fitted from deviation_from_baseline's, then refitted)",
+            n(z)
+        )),
+        (None, None) => None,
+    }
+}
+
+/// The fitted contact point's piezo height (m) of the fit `r` of a curve under the spring
+/// constant `k`: the topography.
+fn contact_height_of(r: &super::fit_result::FitResult, k: f64) -> f64 {
+    let value = |name: &str| {
+        let i = r.names.iter().position(|n| *n == name);
+        i.map_or(0.0, |i| r.outcome.values[i])
+    };
+    value(CONTACT_POINT) + r.curve.tip_offset - (r.curve.force_offset + value(BASELINE)) / k
+}
+
+/// The sample's thickness under a contact at the piezo height `contact` above the substrate's
+/// `z` (m).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `substrate_height` when the contact is not above it.
+fn thickness_above(z: f64, contact: f64) -> Result<f64, SimError> {
+    let h = contact - z;
+    if h > 0.0 && h.is_finite() {
+        return Ok(h);
+    }
+    Err(SimError::out_of_range(
+        "substrate_height",
+        crate::error::number(z),
+        format!(
+            "the curve's contact point is at the piezo height {} m, not above the substrate: \
+             no sample to correct for",
+            crate::error::number(contact)
+        ),
+    ))
 }
 
 /// The map's failure when no curve was fitted at all (the first curve's reason): no answer.
@@ -255,6 +353,7 @@ fn failed(c: &MapCurve, n: usize, reason: String) -> CurveFit {
         chi2_dof: None,
         contact_rows: 0,
         contact_height: None,
+        thickness: None,
         flag: CurveFlag::Failed,
         reason: Some(reason),
         data_warning: None,

@@ -247,7 +247,10 @@ fn plan_of(recipe: Recipe, eager: bool) -> Result<Box<dyn Plan>, SimError> {
                 params,
                 probe: probe
                     .as_deref()
-                    .map(|t| crate::probe::Probe::parse(t, "probe"))
+                    .map(|t| {
+                        let needs = crate::request::Request::probe_needs(&request);
+                        crate::probe::Probe::parse_for(t, "probe", needs)
+                    })
                     .transpose()
                     .map_err(|e| SimError::Probe(format!("probe {e}")))?,
             };

@@ -402,6 +402,10 @@ pub trait Stored: Send {
     /// # Errors
     /// The request's validation errors.
     fn prepare(self: Box<Self>, model: Resolved) -> Result<Box<dyn Prepared>, SimError>;
+    /// What the request uses of its probe ([`crate::request::run::Request::probe_needs`]).
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Oscillation
+    }
 }
 
 /// A study ready to run into a store.
@@ -433,6 +437,9 @@ where
         let study = self.request.study(&model)?;
         self.ready = Some((model, study));
         Ok(self)
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        self.request.probe_needs()
     }
 }
 

@@ -79,6 +79,9 @@ pub struct CurveFit {
     pub contact_rows: usize,
     /// The contact point's piezo height (m): the topography.
     pub contact_height: Option<f64>,
+    /// The sample's thickness the curve was fitted with (m; `None`: infinitely thick).
+    #[serde(default)]
+    pub thickness: Option<f64>,
     /// How the fit ended.
     pub flag: CurveFlag,
     /// Why it is flagged (`None` when fitted).
@@ -109,6 +112,9 @@ pub struct FitMap {
     /// The range of tip positions fitted (m, relative to each curve's contact point by the
     /// deviation from the baseline), `None`: the whole segment.
     pub range: Option<[f64; 2]>,
+    /// The bottom-effect correction: how each curve's thickness was given (`None`: an
+    /// infinitely thick sample).
+    pub layer: Option<String>,
 }
 
 /// The median and the 16th and 84th percentiles of `v` (finite values; `None` when empty).
