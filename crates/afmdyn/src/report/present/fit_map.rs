@@ -104,6 +104,9 @@ fn csv(m: &FitMap) -> String {
         header.push(format!("{}_standard_error", short_name(n)));
     }
     header.extend(["chi2_dof", "contact_rows", "topography"].map(String::from));
+    if m.layer.is_some() {
+        header.push("thickness".into());
+    }
     let mut text = header.join(",") + "\n";
     let f = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v:e}"));
     for c in &m.curves {
@@ -118,6 +121,9 @@ fn csv(m: &FitMap) -> String {
             c.contact_rows.to_string(),
             f(c.contact_height),
         ]);
+        if m.layer.is_some() {
+            row.push(f(c.thickness));
+        }
         text.push_str(&row.join(","));
         text.push('\n');
     }
