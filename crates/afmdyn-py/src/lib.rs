@@ -65,6 +65,10 @@ fn si_value(text: &str, name: &str, want: &str, si: bool) -> PyResult<f64> {
 /// Compiled core of afmdyn (use the `afmdyn` package, not this module).
 #[pymodule]
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API is loaded here, at import, not at a run's first array: a Ctrl-C landing
+    // while NumPy is imported then fails the import, not a run (rust-numpy panics when the
+    // capsule's import is interrupted)
+    numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add_class::<params::PyParams>()?;
     m.add_class::<chart::ChartStudy>()?;
     m.add_class::<chart::StoreLock>()?;

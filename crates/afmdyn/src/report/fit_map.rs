@@ -33,7 +33,8 @@ pub fn unit_of(key: &str) -> &'static str {
 /// (`summary`),
 /// `curves` (each curve's `x`, `y`, `ix`, `iy`, `estimates` keyed as `fit`'s with `value`,
 /// `standard_error` and `interval`, `chi2_dof`, `contact_rows`, `contact_height`, `flag`,
-/// `reason`, and `thickness` where the bottom effect is corrected), `units`, `preprocessing`
+/// `reason`, `spring_constant` (N/m, the file's for the curve, else the probe's), and
+/// `thickness` where the bottom effect is corrected), `units`, `preprocessing`
 /// (nanite's steps, how the contact point is found, the segment, `range_x` and
 /// `bottom_effect`: how the sample's thickness was given), `method` and `warnings`.
 pub fn document(m: &FitMap) -> Value {
@@ -64,6 +65,7 @@ pub fn document(m: &FitMap) -> Value {
     units.insert("x".into(), json!("m"));
     units.insert("contact_height".into(), json!("m"));
     units.insert("thickness".into(), json!("m"));
+    units.insert("spring_constant".into(), json!("N/m"));
     units.insert("chi2_dof".into(), json!("N^2"));
     json!({
         "law": m.law.name(),
@@ -110,6 +112,7 @@ fn curve_entry(m: &FitMap, c: &CurveFit) -> Value {
         "chi2_dof": c.chi2_dof,
         "contact_rows": c.contact_rows,
         "contact_height": c.contact_height,
+        "spring_constant": c.spring_constant,
         "thickness": c.thickness,
         "flag": c.flag,
         "reason": c.reason,
@@ -160,7 +163,7 @@ fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> 
 /// The map's layout over (y, x): the coordinates `x`, `y` (m); per fitted parameter its
 /// value, `_standard_error`, `_lower` and `_upper` (the 95 % interval) named by
 /// [`short_name`]; `chi2_dof` (N²), `contact_rows`, `topography` (the contact point's
-/// piezo height, m), `thickness` (m, where the bottom effect is corrected) and `flag` (CF `flag_values`/`flag_meanings`: [`CurveFlag::NAMES`]).
+/// piezo height, m), `spring_constant` (N/m), `thickness` (m, where the bottom effect is corrected) and `flag` (CF `flag_values`/`flag_meanings`: [`CurveFlag::NAMES`]).
 pub fn layout(m: &FitMap) -> Layout {
     let (nx, ny) = (m.xs.len(), m.ys.len());
     let at = |c: &CurveFit| c.iy * nx + c.ix;
@@ -236,6 +239,13 @@ pub fn layout(m: &FitMap) -> Layout {
         "m",
         "the contact point's piezo height",
         &grid(&|c| c.contact_height),
+    ));
+    vars.push(Variable::f64(
+        "spring_constant",
+        d,
+        "N/m",
+        "the lever's spring constant the curve was fitted with (the file's, else the probe's)",
+        &grid(&|c| c.spring_constant),
     ));
     if m.layer.is_some() {
         vars.push(Variable::f64(

@@ -125,10 +125,26 @@ pub(crate) fn unit_slip(
 
 /// The smallest and largest of the finite values of `v` ((∞, −∞) for none).
 pub(crate) fn extent(v: &[f64]) -> (f64, f64) {
-    let finite = v.iter().filter(|x| x.is_finite());
-    finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-        (lo.min(*x), hi.max(*x))
-    })
+    // eight independent lanes, so that a long column's pass vectorises (a map's curves of
+    // 24 000 rows); a value not finite becomes NaN, which f64::min and max pass over
+    const LANES: usize = 8;
+    let mut lo = [f64::INFINITY; LANES];
+    let mut hi = [f64::NEG_INFINITY; LANES];
+    let finite = |x: f64| if x.is_finite() { x } else { f64::NAN };
+    let chunks = v.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for i in 0..LANES {
+            lo[i] = lo[i].min(finite(c[i]));
+            hi[i] = hi[i].max(finite(c[i]));
+        }
+    }
+    for (i, &x) in rest.iter().enumerate() {
+        lo[i] = lo[i].min(finite(x));
+        hi[i] = hi[i].max(finite(x));
+    }
+    let lo = lo.into_iter().fold(f64::INFINITY, f64::min);
+    (lo, hi.into_iter().fold(f64::NEG_INFINITY, f64::max))
 }
 
 /// The span max − min of the finite values of `v` (0 for fewer than two).
@@ -217,6 +233,24 @@ impl Quantity {
 
 #[cfg(test)]
 mod tests {
+
+    /// The lanes' extent is the plain one: finite values only, any length, none at all.
+    #[test]
+    fn extent_is_the_finite_values_min_and_max() {
+        for n in [0, 1, 7, 8, 9, 23, 100] {
+            let mut v: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+            if n > 3 {
+                v[1] = f64::NAN;
+                v[2] = f64::INFINITY;
+                v[n - 1] = f64::NEG_INFINITY;
+            }
+            let finite = v.iter().copied().filter(|x| x.is_finite());
+            let want = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+            assert_eq!(super::extent(&v), want, "{n}");
+        }
+    }
     /// The likely unit of a slip is the one that brings the column nearest the middle of its
     /// range; within the range, or for an empty column, nothing is said.
     #[test]

@@ -40,6 +40,7 @@ pub fn first_difference(then: &Value, now: &Value) -> Option<(String, String, St
     fn show(v: Option<&Value>) -> String {
         match v {
             None => "absent".into(),
+            Some(Value::Null) => "not given (its default)".into(),
             Some(Value::String(s)) => s.clone(),
             Some(v) => v.to_string(),
         }

@@ -194,8 +194,8 @@ pub(crate) fn data_warnings(height: &[f64], force: &[f64], k: f64) -> Vec<String
 /// preprocessing's offset): the fit has not found the contact (issue 77 item 4: a curve in nm
 /// and nN gave −1445 m).
 fn contact_point_warning(tip: &[f64], contact: f64) -> Option<String> {
-    let h = crate::request::quantity::span(tip);
     let (lo, hi) = crate::request::quantity::extent(tip);
+    let h = (hi - lo).max(0.0);
     (contact < lo - h || contact > hi + h).then(|| {
         format!(
             "contact_point = {contact:.4e} m lies far outside the tip positions measured \
@@ -331,7 +331,8 @@ impl FitRequest {
                 .warnings
                 .extend(sls_start_warning(model, &outcome.values));
         }
-        outcome.warnings.extend(data_warnings(c.height, c.force, k));
+        let data = data_warnings(c.height, c.force, k);
+        outcome.warnings.extend(data.iter().cloned());
         let contact = names.iter().position(|n| *n == CONTACT_POINT);
         // the contact point is a tip position after the preprocessing's offset: held against
         // those, not the file's piezo heights (an instrument's are absolute: 18–23 µm)
@@ -347,6 +348,7 @@ impl FitRequest {
             names,
             fitted,
             outcome,
+            data_warnings: data,
             dynamic: None,
         })
     }

@@ -122,6 +122,7 @@ pub(crate) fn execute(
         fitted: vec![true; names.len()],
         names,
         outcome,
+        data_warnings: Vec::new(),
         dynamic: Some(DynamicFit {
             data,
             channels,

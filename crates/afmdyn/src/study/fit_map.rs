@@ -199,12 +199,11 @@ impl MapStudy {
             chi2_dof: finite(o.chi2_dof),
             contact_rows,
             contact_height: finite(contact_height),
+            spring_constant: Some(k),
             thickness,
             flag,
             reason,
-            data_warning: super::fit::data_warnings(&rows.height, &rows.force, k)
-                .into_iter()
-                .next(),
+            data_warning: r.data_warnings.first().cloned(),
             shown,
         }
     }
@@ -353,6 +352,7 @@ fn failed(c: &MapCurve, n: usize, reason: String) -> CurveFit {
         chi2_dof: None,
         contact_rows: 0,
         contact_height: None,
+        spring_constant: c.spring_constant,
         thickness: None,
         flag: CurveFlag::Failed,
         reason: Some(reason),

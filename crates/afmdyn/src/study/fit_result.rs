@@ -49,6 +49,9 @@ pub struct FitResult {
     pub fitted: Vec<bool>,
     /// The fit.
     pub outcome: FitOutcome,
+    /// The curve's columns held against the probe that look off (a unit slip, another
+    /// lever's spring constant), also among `outcome`'s warnings.
+    pub data_warnings: Vec<String>,
     /// The dynamic fit's data and channels, when the data are an AM or FM curve
     /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
     pub dynamic: Option<DynamicFit>,

@@ -79,6 +79,10 @@ pub struct CurveFit {
     pub contact_rows: usize,
     /// The contact point's piezo height (m): the topography.
     pub contact_height: Option<f64>,
+    /// The lever's spring constant the curve was fitted with (N/m): the map file's for the
+    /// curve, else the probe's.
+    #[serde(default)]
+    pub spring_constant: Option<f64>,
     /// The sample's thickness the curve was fitted with (m; `None`: infinitely thick).
     #[serde(default)]
     pub thickness: Option<f64>,
