@@ -103,7 +103,7 @@ fn csv(m: &FitMap) -> String {
         header.push(short_name(n));
         header.push(format!("{}_standard_error", short_name(n)));
     }
-    header.extend(["chi2_dof", "contact_rows", "topography"].map(String::from));
+    header.extend(["chi2_dof", "contact_rows", "topography", "spring_constant"].map(String::from));
     if m.layer.is_some() {
         header.push("thickness".into());
     }
@@ -120,6 +120,7 @@ fn csv(m: &FitMap) -> String {
             f(c.chi2_dof),
             c.contact_rows.to_string(),
             f(c.contact_height),
+            f(c.spring_constant),
         ]);
         if m.layer.is_some() {
             row.push(f(c.thickness));
