@@ -222,6 +222,13 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "args": {"data": 'required = true, value_name = "FILE"',
                  "range": 'value_name = "LO,HI"'},
     },
+    # `thermal`: the free lever's thermal spectrum (a probe's)
+    "ThermalFlags": {
+        "file": "afm",
+        "schema": "thermal",
+        "order": ["temperature", "spot", "to", "points"],
+        "args": {"points": 'value_name = "N"'},
+    },
     "LyapunovFlags": {
         "schema": "lyapunov",
         "given": {"initial": "Option<Vec<f64>>"},

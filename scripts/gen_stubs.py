@@ -56,6 +56,7 @@ RUN = [
     ("peakforce", "peakforce"),
     ("fit", "fit"),
     ("fit_map", "fit_map"),
+    ("thermal", "thermal"),
 ]
 #: the studies run into a store through ``_afmdyn.run_stored`` (the library's
 #: ``study::stored::parse``) and their schema files

@@ -86,6 +86,7 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "bimodal": ("approach", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "fm": ("fm", "_fm", "xr.Dataset", {}),
+        "thermal": ("thermal", "_api", "xr.Dataset", {}),
         "peakforce": ("peakforce", "_peakforce", "xr.Dataset", {
             "omit": ("sweep",),
             "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),

@@ -248,6 +248,31 @@ Raises:
     },
 }
 
+WRAPPERS["thermal"] = {
+    "summary": """\
+The free lever's thermal spectrum at ``temperature`` (``afmdyn thermal``; a probe is
+needed): from the fluctuation–dissipation theorem on the lever's dynamic compliance over every
+Galerkin mode (the tip mass, the medium's added mass and damping per mode), the one-sided power
+spectral densities of the tip's deflection and of the optical lever's apparent deflection (the
+slope at the laser ``spot``, a fraction of the length, converted with the static end-load
+factor; Butt & Jaschke 1995), and each mode's frequency, Q, effective spring constant,
+mean-square deflection and the thermal method's correction factors (0.971 and 0.817 for the
+first mode of a uniform lever).""",
+    "returns": """\
+Returns:
+    An ``xarray.Dataset`` over ``frequency`` (Hz) with ``deflection`` and
+    ``apparent_deflection`` (m²/Hz), and over ``mode`` the ``modes_*`` variables
+    (``modes_frequency`` Hz, ``modes_quality_factor``, ``modes_effective_spring_constant``
+    N/m, ``modes_mean_square_deflection`` and ``modes_mean_square_apparent_deflection`` m²,
+    ``modes_deflection_factor``, ``modes_optical_lever_factor``); attributes
+    ``temperature`` (K), ``spring_constant`` (the static stiffness, N/m), ``spot`` and
+    ``summary`` (the ``afmdyn thermal --json`` document).""",
+    "raises": """\
+Raises:
+    ValueError: naming the option (``temperature``, ``spot``, ``to``, ``points``), the
+        missing probe or the model parameter.""",
+}
+
 WRAPPERS["chart"] = {
     "summary": """\
 Behaviour chart over two parameters (``afmdyn chart``): every attractor that each cell's
@@ -579,7 +604,7 @@ Returns:
     },
 }
 
-AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "fit_map", "image",
+AFM = ("observe", "approach", "bimodal", "resonance", "fm", "thermal", "peakforce", "fit", "fit_map", "image",
        "setpoint_study", "reconstruct")
 STARTS = ("attractors", "basins", "global_continuation")
 DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM + STARTS},

@@ -5,7 +5,7 @@
 
 use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{FitMapRequest, FitRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
+use afmdyn::request::{FitMapRequest, FitRequest, ThermalRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`ImageRequest`]'s fields (generated from its schema).
@@ -219,6 +219,38 @@ impl FitMapFlags {
             substrate_height: quantity(self.substrate_height, "substrate-height", Dim::Length, si)?,
             thickness: quantity(self.thickness, "thickness", Dim::Length, si)?,
             threads: self.threads,
+        })
+    }
+}
+
+/// The flags of [`ThermalRequest`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct ThermalFlags {
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
+    pub temperature: Option<f64>,
+    /// `--spot`: the request's `spot`.
+    #[arg(long, allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the lever's length from its base (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.")]
+    pub spot: Option<f64>,
+    /// `--to`: the request's `to`.
+    #[arg(long, allow_hyphen_values = true, help = "The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's frequency, at least 3 f₀. With --probe a unit may follow (300kHz).")]
+    pub to: Option<Quantity>,
+    /// `--points`: the request's `points`.
+    #[arg(long, value_name = "N", help = "The number of frequencies, evenly spaced from to/points to --to (1 to 10⁷; default 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the spectrum; each mode's share is exact whatever the spacing.")]
+    pub points: Option<usize>,
+}
+
+impl ThermalFlags {
+    /// The [`ThermalRequest`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`).
+    pub fn request(&self, si: bool) -> Result<ThermalRequest, CliError> {
+        Ok(ThermalRequest {
+            points: self.points,
+            spot: self.spot,
+            temperature: self.temperature,
+            to: quantity(self.to, "to", Dim::Frequency, si)?,
         })
     }
 }

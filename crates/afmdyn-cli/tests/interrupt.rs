@@ -178,6 +178,18 @@ fn case(name: &str) -> Option<Case> {
             ],
             out: true,
         },
+        "thermal" => Long {
+            args: &[
+                "thermal",
+                "--probe",
+                "examples/probe-beam-dmt.toml",
+                "--modes",
+                "20",
+                "--points",
+                "1000000",
+            ],
+            out: true,
+        },
         _ => return None,
     })
 }

@@ -25,6 +25,7 @@ mod probe_text;
 mod reconstruct;
 mod request_flags;
 mod silent_answers;
+mod thermal;
 mod wasm_api;
 
 /// Every tests/*.rs file is a module above: with `autotests = false` cargo no longer builds a

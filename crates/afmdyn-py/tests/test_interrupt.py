@@ -154,6 +154,9 @@ LONG = {
         """,
         "afmdyn.fit_map(data=tmp + '/map.nc', probe=EX + '/probe-fit-hertz.toml', progress=p)",
     ),
+    # a million frequencies of a twenty-mode beam (seconds)
+    "thermal": ("", "afmdyn.thermal(probe=EX + '/probe-beam-dmt.toml', modes=20, "
+                    "points=10**6, progress=p)"),
 }
 
 

@@ -372,7 +372,8 @@ def test_every_request_has_a_schema() -> None:
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
          "approach", "resonance", "chart", "global_continuation", "basins", "reconstruct",
-         "fm", "image", "image_scan", "image_options", "peakforce", "fit", "fit_map"]
+         "fm", "image", "image_scan", "image_options", "peakforce", "fit", "fit_map",
+         "thermal"]
     )
 
 

@@ -201,6 +201,8 @@ fn within_three_times<A: afmdyn::request::Analysis>(
 const PEAKFORCE: &str = include_str!("../../../examples/probe-peakforce-amo-garcia.toml");
 const FIT: &str = include_str!("../../../examples/probe-fit-hertz.toml");
 const BIMODAL: &str = include_str!("../../../examples/probe-bimodal.toml");
+/// A three-mode beam probe (`thermal`).
+const BEAM: &str = include_str!("../../../examples/probe-beam-dmt.toml");
 const FM: &str = include_str!("../../../examples/probe-point-mass-dmt.toml");
 
 /// A request kind's cases: the model, its keywords at two sizes (each run to its end), and at
@@ -403,6 +405,15 @@ fn case(name: &str) -> Option<Case> {
             probe: Some(FIT),
             sizes: [hertz_map(2, 1000), hertz_map(8, 2000)],
             long: Some(hertz_map(40, 400)),
+            long_params: None,
+        },
+        "thermal" => Case {
+            // twenty modes: a frequency's factorisation takes µs, a million of them seconds
+            probe: Some(Box::leak(
+                BEAM.replace("modes = 3", "modes = 20").into_boxed_str(),
+            )),
+            sizes: [json!({"points": 1000}), json!({"points": 100000})],
+            long: Some(json!({"points": 1000000})),
             long_params: None,
         },
         _ => return None,

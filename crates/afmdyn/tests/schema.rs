@@ -94,6 +94,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
             "fit_map",
             schema::<afmdyn::request::FitMapRequest>("fit_map"),
         ),
+        (
+            "thermal",
+            schema::<afmdyn::request::ThermalRequest>("thermal"),
+        ),
     ]
 }
 

@@ -463,6 +463,17 @@ FitMapRequest = TypedDict(
     total=False,
 )
 
+ThermalRequest = TypedDict(
+    "ThermalRequest",
+    {
+        "points": Optional[int],  # default null
+        "spot": Optional[float],  # default null
+        "temperature": Optional[float],  # default null
+        "to": Optional[float],  # default null
+    },
+    total=False,
+)
+
 BifurcationRequest = TypedDict(
     "BifurcationRequest",
     {
@@ -670,6 +681,15 @@ def run(
 def run(
     name: Literal["fit_map"],
     request: Optional[FitMapRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["thermal"],
+    request: Optional[ThermalRequest] = None,
     params: Optional[Params] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,

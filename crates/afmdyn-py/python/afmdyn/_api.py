@@ -150,6 +150,21 @@ def _finish_observe(a: Args) -> xr.Dataset:
     return ds
 
 
+def _finish_thermal(a: Args) -> xr.Dataset:
+    """The free lever's thermal spectrum (``afmdyn thermal``): the one-sided PSDs of the tip's
+    deflection and of the optical lever's apparent deflection over ``frequency`` (m²/Hz), each
+    mode's share over ``mode`` (``modes_*`` variables); ``attrs["summary"]`` is the document."""
+    p, probe = _params(a["params"], a["model"])
+    d = _door("thermal", "thermal", a["progress"], p, probe, _request(a))
+    ds = _layout.dataset(d["datasets"]["thermal"])
+    modes = _layout.dataset(d["datasets"]["modes"])
+    for name, var in modes.data_vars.items():
+        ds[f"modes_{name}"] = var
+    ds.attrs = {"title": "afmdyn thermal", "summary": d["json"],
+                **{k: v for k, v in d["facts"].items() if isinstance(v, (int, float))}}
+    return ds
+
+
 def _curve(desc: str, a: Args) -> xr.Dataset:
     """Run a stepped-curve analysis (``approach``, ``bimodal``, ``resonance``) — in the command
     line's resumable store ``store`` when given — and return its dataset

@@ -32,6 +32,7 @@ __all__ = [
     "bimodal",
     "resonance",
     "fm",
+    "thermal",
     "peakforce",
     "fit",
     "fit_map",
@@ -645,6 +646,58 @@ def fm(
             ``step``, ``points``) or the model parameter.
     """
     return _fm._finish_fm(locals())
+
+
+@_typed(si={"to": "frequency"})
+def thermal(
+    params: Optional[Params] = None,
+    /,
+    *,
+    points: Optional[int] = None,
+    spot: Optional[float] = None,
+    temperature: Optional[float] = None,
+    to: Optional[float] = None,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """The free lever's thermal spectrum at ``temperature`` (``afmdyn thermal``; a probe is
+    needed): from the fluctuation–dissipation theorem on the lever's dynamic compliance over every
+    Galerkin mode (the tip mass, the medium's added mass and damping per mode), the one-sided power
+    spectral densities of the tip's deflection and of the optical lever's apparent deflection (the
+    slope at the laser ``spot``, a fraction of the length, converted with the static end-load
+    factor; Butt & Jaschke 1995), and each mode's frequency, Q, effective spring constant,
+    mean-square deflection and the thermal method's correction factors (0.971 and 0.817 for the
+    first mode of a uniform lever).
+
+    Args:
+        points: The number of frequencies, evenly spaced from to/points to ``to`` (1 to 10⁷;
+            default 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved
+            in the spectrum; each mode's share is exact whatever the spacing.
+        spot: The optical lever's laser spot ξ_s, a fraction of the lever's length from its
+            base (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the
+            slope there.
+        temperature: The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K
+            it warns (a value in °C?).
+        to: The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest
+            mode's frequency, at least 3 f₀.
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        An ``xarray.Dataset`` over ``frequency`` (Hz) with ``deflection`` and
+        ``apparent_deflection`` (m²/Hz), and over ``mode`` the ``modes_*`` variables
+        (``modes_frequency`` Hz, ``modes_quality_factor``, ``modes_effective_spring_constant``
+        N/m, ``modes_mean_square_deflection`` and ``modes_mean_square_apparent_deflection`` m²,
+        ``modes_deflection_factor``, ``modes_optical_lever_factor``); attributes
+        ``temperature`` (K), ``spring_constant`` (the static stiffness, N/m), ``spot`` and
+        ``summary`` (the ``afmdyn thermal --json`` document).
+
+    Raises:
+        ValueError: naming the option (``temperature``, ``spot``, ``to``, ``points``), the
+            missing probe or the model parameter.
+    """
+    return _api._finish_thermal(locals())
 
 
 @_typed(si={"filter_cutoff": "frequency", "setpoint": "force", "z_c": "length"})

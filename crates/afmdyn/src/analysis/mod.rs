@@ -38,6 +38,7 @@ pub(crate) mod spectrum;
 pub mod steady;
 pub mod stepped;
 pub(crate) mod tasks;
+pub mod thermal;
 pub mod torus;
 pub mod traces;
 

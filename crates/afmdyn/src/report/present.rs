@@ -24,6 +24,7 @@ pub(crate) mod orbits;
 pub mod peakforce;
 pub mod reconstruct;
 pub(crate) mod sweeps;
+pub(crate) mod thermal;
 
 /// Which files a presentation holds (`--files`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

@@ -55,6 +55,7 @@ pub mod named;
 pub mod peakforce;
 pub(crate) mod peakforce_sweep;
 pub mod quantity;
+pub mod thermal;
 
 pub mod reconstruct;
 pub(crate) mod reconstruct_document;
@@ -85,6 +86,7 @@ pub use run::{
     admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document,
     Presenting, Request, Resolved, ResonanceRequest,
 };
+pub use thermal::ThermalRequest;
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a
 // run counts in, the results the curve and reconstruction requests return, the integrators a

@@ -22,7 +22,7 @@ use serde::de::{Deserialize, Deserializer};
 use serde_json::Value;
 
 /// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 18] = [
+pub const NAMES: [&str; 19] = [
     "modes",
     "simulate",
     "converge",
@@ -41,6 +41,7 @@ pub const NAMES: [&str; 18] = [
     "peakforce",
     "fit",
     "fit_map",
+    "thermal",
 ];
 
 /// An analysis request parsed by name ([`parse`]): the request of its name, as data. Its
@@ -90,6 +91,8 @@ pub(crate) enum Parsed {
     Fit(FitRequest),
     /// `fit_map`.
     FitMap(super::FitMapRequest),
+    /// `thermal`.
+    Thermal(super::ThermalRequest),
 }
 
 /// `$body` on the request `$r` of every variant of a [`NamedRequest`]'s `Parsed` but `simulate` (its
@@ -116,6 +119,7 @@ macro_rules! each_request {
             $crate::request::named::Parsed::PeakForce($r) => $body,
             $crate::request::named::Parsed::Fit($r) => $body,
             $crate::request::named::Parsed::FitMap($r) => $body,
+            $crate::request::named::Parsed::Thermal($r) => $body,
             $crate::request::named::Parsed::Simulate($s) => $simulate,
             $crate::request::named::Parsed::ReconstructDocument($f) => $document,
         }
@@ -191,6 +195,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "peakforce" => door(d, N::PeakForce),
         "fit" => door(d, N::Fit),
         "fit_map" => door(d, N::FitMap),
+        "thermal" => door(d, N::Thermal),
         _ => Ok(None),
     }
 }
@@ -222,6 +227,7 @@ pub fn default_request(name: &str) -> Option<Value> {
         "peakforce" => v::<super::PeakForceRequest>(),
         "fit" => v::<super::FitRequest>(),
         "fit_map" => v::<super::FitMapRequest>(),
+        "thermal" => v::<super::ThermalRequest>(),
         _ => None,
     }
 }

@@ -90,6 +90,7 @@ pub mod stored;
 pub mod sweep;
 #[cfg(feature = "files")]
 pub(crate) mod task_store;
+pub(crate) mod thermal;
 
 pub use analyses::advance_from_rest;
 pub(crate) use kinds::{in_order, Chain, Tasks};

@@ -29,11 +29,11 @@
 //! so the law's dimensionless force is the SI force with g₀ = 1 m and F̃ = 1 N.
 //!
 //! # Indenter shapes and finite thickness
-//! Under the Hertz law the tip's shape (`[tip] shape`, [`crate::contact::indenter`]) gives
+//! Under the Hertz law the tip's shape (`[tip] shape`, `contact::indenter`) gives
 //! F_c = E* g(δ) c(δ): g the shape's force per unit E* (the paraboloid's (4/3)√R δ^{3/2},
 //! Sneddon's exact sphere, cone, the pyramids, the flat punch) and c the bottom-effect factor
 //! of a sample of the request's `thickness` (1 without; Dimitriadis et al. 2002, Garcia &
-//! Garcia 2018: [`crate::contact::indenter::bottom_effect`]). A shape without a radius has no
+//! Garcia 2018: `contact::indenter::bottom_effect`). A shape without a radius has no
 //! `tip.radius` parameter; its angle is held. ∂F/∂E_s = g c ∂E*/∂E_s, ∂F/∂R and ∂F/∂δ are the
 //! shape's and the factor's exact derivatives.
 //!

@@ -1,0 +1,141 @@
+//! `thermal`: the free lever's thermal spectrum at a temperature — the request the command line
+//! (`afmdyn thermal --probe P.toml`) and Python (`afmdyn.thermal`) share: its options, their
+//! ranges and its declared cost ([`crate::analysis::thermal`] computes it).
+
+use super::costs::{MODEL_BYTES, OPERATION_WORK};
+use super::limits::Cost;
+use super::run::{Request, Resolved};
+use crate::error::SimError;
+use serde::{Deserialize, Serialize};
+
+/// The default temperature (K): a laboratory's 22 °C.
+pub const DEFAULT_TEMPERATURE: f64 = 295.0;
+
+/// The physical range of the temperature (K): above absolute zero, below where a silicon lever
+/// stays a lever.
+pub const TEMPERATURE_RANGE: (f64, f64) = (0.0, 1500.0);
+
+/// The temperatures of a measurement in a laboratory (K): a cooled to a heated stage. Below
+/// them a value is either a cryogenic AFM's or in °C (22 for 295.15 K): it warns.
+pub const TYPICAL_TEMPERATURE: (f64, f64) = (200.0, 500.0);
+
+/// The default and the largest number of frequencies of the spectrum.
+pub const DEFAULT_POINTS: usize = 4096;
+/// The largest number of frequencies (10⁷, 240 MB of spectrum).
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// `thermal`: the temperature, the laser spot of the optical lever and the frequencies of the
+/// one-sided power spectral density (SI). Needs a probe.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct ThermalRequest {
+    /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
+    /// value in °C?).
+    pub temperature: Option<f64>,
+    /// The optical lever's laser spot ξ_s, a fraction of the lever's length from its base
+    /// (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.
+    pub spot: Option<f64>,
+    /// The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's
+    /// frequency, at least 3 f₀.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+    pub to: Option<f64>,
+    /// The number of frequencies, evenly spaced from to/points to `to` (1 to 10⁷; default
+    /// 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the
+    /// spectrum; each mode's share is exact whatever the spacing.
+    pub points: Option<usize>,
+}
+
+impl ThermalRequest {
+    /// The temperature (K).
+    pub fn temperature(&self) -> f64 {
+        self.temperature.unwrap_or(DEFAULT_TEMPERATURE)
+    }
+
+    /// The laser spot (a fraction of the length).
+    pub fn spot(&self) -> f64 {
+        self.spot.unwrap_or(1.0)
+    }
+
+    /// The number of frequencies.
+    pub fn points(&self) -> usize {
+        self.points.unwrap_or(DEFAULT_POINTS)
+    }
+
+    /// The warning of a temperature outside the typical range, naming the likely slip.
+    pub fn warnings(&self) -> Vec<String> {
+        let t = self.temperature();
+        let (lo, hi) = TYPICAL_TEMPERATURE;
+        if (lo..=hi).contains(&t) {
+            return Vec::new();
+        }
+        vec![format!(
+            "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
+             in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
+            t + 273.15
+        )]
+    }
+}
+
+fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimError {
+    SimError::out_of_range(name, value.to_string(), allowed)
+}
+
+impl Request for ThermalRequest {
+    const COST_ADVICE: &'static str = "ask for fewer points";
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        model.params.validate_fields()?;
+        if model.probe.is_none() {
+            return Err(bad(
+                "probe",
+                "missing",
+                "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
+            ));
+        }
+        let t = self.temperature();
+        let (lo, hi) = TEMPERATURE_RANGE;
+        if !(t > lo && t <= hi) {
+            return Err(bad(
+                "temperature",
+                crate::error::number(t),
+                "the temperature must be above absolute zero and at most 1500 K (K)",
+            ));
+        }
+        let spot = self.spot();
+        if !(spot > 0.0 && spot <= 1.0) {
+            return Err(bad(
+                "spot",
+                crate::error::number(spot),
+                "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1",
+            ));
+        }
+        if let Some(f) = self.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
+            return Err(bad(
+                "to",
+                crate::error::number(f),
+                "the highest frequency must be finite and > 0 (Hz)",
+            ));
+        }
+        if !(1..=MAX_POINTS).contains(&self.points()) {
+            return Err(bad(
+                "points",
+                self.points(),
+                "the number of frequencies must be 1..=10000000",
+            ));
+        }
+        Ok(())
+    }
+    fn name(&self) -> &'static str {
+        "thermal"
+    }
+    /// An N × N complex factorisation per frequency; the spectrum's columns, their copies in
+    /// the layouts and the document's JSON values (256 bytes a frequency).
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        let n = model.params.modes as f64;
+        let points = self.points() as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + points * 256.0,
+            work: points * OPERATION_WORK * (n * n * n + 4.0 * n * n),
+        })
+    }
+}
