@@ -3,30 +3,19 @@
 //! its files; a missing probe, a spot off the lever and a temperature at absolute zero refused
 //! with exit 2 and one line naming the option; a temperature in °C warned of.
 
-use std::process::{Command, Output};
+use crate::common::{json, run as afmdyn};
 
-fn afmdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
-        .args(args)
-        .output()
-        .expect("run afmdyn")
-}
-
-const PROBE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../examples/probe-point-mass-dmt.toml"
-);
+/// The probe (the tests run in the repository's root).
+const PROBE: &str = "examples/probe-point-mass-dmt.toml";
 
 #[test]
 fn a_point_mass_lever_carries_kt_over_k() {
     let dir = std::env::temp_dir().join(format!("afmdyn-thermal-{}", std::process::id()));
     let out = dir.display().to_string();
     // 2 frequencies: f₀ and 2 f₀
-    let o = afmdyn(&[
+    let doc = json(&[
         "thermal", "--probe", PROBE, "--to", "600kHz", "--points", "2", "--json", "--out", &out,
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let kt = 1.380_649e-23 * 295.0;
     let (k, f0, q) = (40.0, 300e3, 400.0);
     let mode = &doc["modes"][0];

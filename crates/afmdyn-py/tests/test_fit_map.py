@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import afmdyn
+from test_fit import _sneddon_sphere
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 PROBE = str(EXAMPLES / "probe-fit-spot3.toml")
@@ -28,21 +29,6 @@ def _fit_map(**kw):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
         return afmdyn.fit_map(probe=PROBE, **kw)
-
-
-def _sneddon_sphere(delta, radius):
-    """Sneddon's exact sphere per unit E* (1965, eqs. 6.13 and 6.15): δ = (a/2) ln((R+a)/(R−a)),
-    F = ½[(a² + R²) ln((R+a)/(R−a)) − 2aR], a found by bisection."""
-    lo, hi = 0.0, radius * (1 - 1e-15)
-    for _ in range(200):
-        a = 0.5 * (lo + hi)
-        if a / 2 * np.log((radius + a) / (radius - a)) < delta:
-            lo = a
-        else:
-            hi = a
-    a = 0.5 * (lo + hi)
-    log = np.log((radius + a) / (radius - a))
-    return 0.5 * ((a * a + radius * radius) * log - 2 * a * radius)
 
 
 def _approximation_error(depth, radius=10e-6):

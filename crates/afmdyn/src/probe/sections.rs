@@ -49,44 +49,10 @@ impl Probe {
         // [tip]: a silicon tip where the section omits its elastic constants (the one
         // materials table, crate::units::SILICON_TIP)
         let tip = r.table(root, "tip", false);
-        let (mut tip_e, mut tip_nu, mut radius) = (None, None, None);
-        let mut shape = TipShape::Paraboloid;
-        if let Some(t) = tip {
-            r.unknown(
-                t,
-                "tip",
-                &[
-                    "radius",
-                    "youngs_modulus",
-                    "poisson_ratio",
-                    "shape",
-                    "half_angle",
-                    "face_angle",
-                ],
-            );
-            radius = r.optional(t, "tip", "radius", "m", POSITIVE);
-            shape = Self::read_shape(&mut r, t);
-            if !shape.has_radius() {
-                if radius.is_some() {
-                    r.warnings.push(format!(
-                        "[tip].radius is not used by the {} shape (the sharp indenter's force \
-                         has no radius)",
-                        shape.name()
-                    ));
-                }
-                // the dimensionless groups' radius, which no analysis that takes this shape
-                // reads (the dynamic ones refuse it: Probe::from_table_for)
-                radius = radius.or(Some(SHAPE_STAND_IN_RADIUS));
-            }
-            tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
-            tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
-            if !t.contains_key("youngs_modulus") {
-                tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
-            }
-            if !t.contains_key("poisson_ratio") {
-                tip_nu = Some(crate::cantilevers::SILICON_POISSON_RATIO);
-            }
-        }
+        let (radius, shape, tip_e, tip_nu) = tip
+            .map_or((None, TipShape::Paraboloid, None, None), |t| {
+                Self::read_tip(&mut r, t)
+            });
         // [sample]
         let sample = r
             .table(root, "sample", true)
@@ -137,6 +103,47 @@ impl Probe {
                 None
             }
         }
+    }
+
+    /// `[tip]`: its radius (m), shape, and elastic constants (Pa, 1), silicon's where the
+    /// section omits them (the one materials table, `crate::cantilevers`); a shape without a
+    /// radius takes a stand-in radius for the dimensionless groups (warned of where given).
+    fn read_tip(
+        r: &mut Reader<'_>,
+        t: &toml::Table,
+    ) -> (Option<f64>, TipShape, Option<f64>, Option<f64>) {
+        let keys = [
+            "radius",
+            "youngs_modulus",
+            "poisson_ratio",
+            "shape",
+            "half_angle",
+            "face_angle",
+        ];
+        r.unknown(t, "tip", &keys);
+        let mut radius = r.optional(t, "tip", "radius", "m", POSITIVE);
+        let shape = Self::read_shape(r, t);
+        if !shape.has_radius() {
+            if radius.is_some() {
+                r.warnings.push(format!(
+                    "[tip].radius is not used by the {} shape (the sharp indenter's force \
+                     has no radius)",
+                    shape.name()
+                ));
+            }
+            // the dimensionless groups' radius, which no analysis that takes this shape
+            // reads (the dynamic ones refuse it: Probe::from_table_for)
+            radius = radius.or(Some(SHAPE_STAND_IN_RADIUS));
+        }
+        let mut tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
+        let mut tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
+        if !t.contains_key("youngs_modulus") {
+            tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
+        }
+        if !t.contains_key("poisson_ratio") {
+            tip_nu = Some(crate::cantilevers::SILICON_POISSON_RATIO);
+        }
+        (radius, shape, tip_e, tip_nu)
     }
 
     /// `[tip] shape` (default the paraboloid) with its angle (degrees): `half_angle` of the

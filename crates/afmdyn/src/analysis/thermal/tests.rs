@@ -22,6 +22,15 @@ fn units(p: &Probe) -> ModelUnits {
     }
 }
 
+/// The tip's deflection PSD of probe `p` at `t` (K) over the frequencies `g` (Hz).
+fn psd(p: &Probe, t: f64) -> impl Fn(&[f64]) -> Vec<f64> + '_ {
+    move |g| {
+        thermal_spectrum(&p.params, units(p), t, 1.0, g, &Progress::default())
+            .unwrap()
+            .deflection
+    }
+}
+
 /// The trapezoid rule's integral of `f` over [0, `to`] on a grid fine about `f0` (step
 /// f₀/(50 Q) within 20 peak widths of it), coarse elsewhere.
 fn integral(f: impl Fn(&[f64]) -> Vec<f64>, f0: f64, q: f64, to: f64) -> f64 {
@@ -71,16 +80,7 @@ fn a_point_mass_is_the_harmonic_oscillator() {
         assert!((m.effective_spring_constant / k - 1.0).abs() < 1e-12);
         assert!((m.quality_factor.unwrap() / q - 1.0).abs() < 1e-9);
         assert!((m.mean_square_deflection / (kt / k) - 1.0).abs() < 1e-12);
-        let area = integral(
-            |g| {
-                thermal_spectrum(&p.params, units(&p), t, 1.0, g, &Progress::default())
-                    .unwrap()
-                    .deflection
-            },
-            f0,
-            q,
-            200.0 * f0,
-        );
+        let area = integral(psd(&p, t), f0, q, 200.0 * f0);
         // the tail beyond 200 f₀: ∫ S ≈ 2k_BT/(πkf₀Q) f₀⁴/(3 f³)
         let tail = 2.0 * kt / (std::f64::consts::PI * k * f0 * q) * f0 / (3.0 * 200f64.powi(3));
         assert!(
@@ -159,16 +159,7 @@ fn the_beams_spectrum_integrates_to_its_static_compliance() {
     let f0 = s.modes[0].frequency;
     let top = s.modes[2].frequency;
     // the grid fine about each mode: the first's by `integral`, the others' at f₀/1000 steps
-    let area = integral(
-        |g| {
-            thermal_spectrum(&p.params, units(&p), t, 1.0, g, &Progress::default())
-                .unwrap()
-                .deflection
-        },
-        f0,
-        20.0,
-        40.0 * top,
-    );
+    let area = integral(psd(&p, t), f0, 20.0, 40.0 * top);
     let want = s.mean_square_deflection;
     assert!((area / want - 1.0).abs() < 1e-3, "{area} vs {want}");
     let truncation = want / (BOLTZMANN * t / ks) - 1.0;
