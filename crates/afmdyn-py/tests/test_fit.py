@@ -189,12 +189,10 @@ def test_a_measured_jpk_curve_fits_as_nanite_fits_it():
     assert lo < ref["E"].value < hi
 
 
-def _nanite_jpk(model_key, module, **held):
-    """nanite 4.2's fit of the JPK curve with ``model_key`` (its module's defaults, the
-    baseline free, the held parameters ``held`` set), after its three preprocessing steps: the
-    fitted parameters and the largest indentation of the fitted rows (m)."""
-    nanite = pytest.importorskip("nanite")
-    idnt = nanite.IndentationGroup(JPK)[0]
+def _nanite_fit(idnt, model_key, module, **held):
+    """nanite 4.2's fit of the indentation ``idnt`` with ``model_key`` (its module's defaults,
+    the baseline free, the held parameters ``held`` set) after its three preprocessing steps,
+    on the whole approach, unweighted: the fitted parameters."""
     idnt.apply_preprocessing(["compute_tip_position", "correct_force_offset", "correct_tip_offset"])
     params = module.get_parameter_defaults()
     params["baseline"].vary = True
@@ -203,7 +201,16 @@ def _nanite_jpk(model_key, module, **held):
     idnt.fit_model(model_key=model_key, params_initial=params, range_x=(0, 0),
                    range_type="absolute", x_axis="tip position", y_axis="force",
                    segment="approach", weight_cp=False)
-    ref = idnt.fit_properties["params_fitted"]
+    return idnt.fit_properties["params_fitted"]
+
+
+def _nanite_jpk(model_key, module, **held):
+    """nanite 4.2's fit of the JPK curve with ``model_key`` (its module's defaults, the
+    baseline free, the held parameters ``held`` set), after its three preprocessing steps: the
+    fitted parameters and the largest indentation of the fitted rows (m)."""
+    nanite = pytest.importorskip("nanite")
+    idnt = nanite.IndentationGroup(JPK)[0]
+    ref = _nanite_fit(idnt, model_key, module, **held)
     approach = np.asarray(idnt["segment"]) == 0
     depth = ref["contact_point"].value - np.min(np.asarray(idnt["tip position"])[approach])
     return ref, depth

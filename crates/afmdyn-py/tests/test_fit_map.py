@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import afmdyn
-from test_fit import _sneddon_sphere
+from test_fit import _nanite_fit, _sneddon_sphere
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 PROBE = str(EXAMPLES / "probe-fit-spot3.toml")
@@ -69,16 +69,7 @@ def test_every_curve_of_an_instrument_map_fits_as_nanite_fits_it(path, shape):
     group = nanite.IndentationGroup(path)
     fitted = 0
     for idnt in group:
-        idnt.apply_preprocessing(["compute_tip_position", "correct_force_offset",
-                                  "correct_tip_offset"])
-        params = getattr(nanite.model, module).get_parameter_defaults()
-        params["baseline"].vary = True
-        for key, value in held.items():
-            params[key].set(value)
-        idnt.fit_model(model_key=model_key, params_initial=params, range_x=(0, 0),
-                       range_type="absolute", x_axis="tip position", y_axis="force",
-                       segment="approach", weight_cp=False)
-        ref = idnt.fit_properties["params_fitted"]
+        ref = _nanite_fit(idnt, model_key, getattr(nanite.model, module), **held)
         m = idnt.metadata
         # the curve's pixel: the map's grid indices, in the order of their positions
         xs = sorted({c.metadata["grid index x"] for c in group})
