@@ -229,6 +229,18 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "order": ["temperature", "spot", "to", "points"],
         "args": {"points": 'value_name = "N"'},
     },
+    # `calibrate`: a measured thermal spectrum (`--psd FILE.csv`) against a probe's modes
+    "CalibrateFlags": {
+        "file": "afm",
+        "schema": "calibrate",
+        "omit": ["frequency", "spectral_density"],
+        "words": ["frequency", "spectral_density", "psd", "height", "deflection"],
+        "order": ["psd", "signal", "volts", "invols", "force_curve", "temperature", "spot",
+                  "peaks", "bands"],
+        "args": {"psd": 'required = true, value_name = "FILE.csv"',
+                 "force_curve": 'value_name = "FILE.csv"', "peaks": 'value_name = "N"',
+                 "bands": 'value_name = "LO,HI,…"'},
+    },
     "LyapunovFlags": {
         "schema": "lyapunov",
         "given": {"initial": "Option<Vec<f64>>"},
@@ -420,8 +432,9 @@ class Field:
         parts = ["long"]
         if self.ty() not in ("bool",) and not self.ty().startswith("Option") and not self.required:
             if isinstance(self.default, list):
-                values = ", ".join(rust_str(str(v)) for v in self.default)
-                parts.append(f"default_values = [{values}]")
+                if self.default:  # (an empty list is the flag not given)
+                    values = ", ".join(rust_str(str(v)) for v in self.default)
+                    parts.append(f"default_values = [{values}]")
             else:
                 parts.append(f"default_value = {rust_str(self.default_text())}")
         if self.rust.startswith("Vec<"):
@@ -481,6 +494,9 @@ class Field:
             dim = "swept" if self.dim == "swept" else DIMS[self.dim][0]
             if self.ty().startswith("Option"):
                 value = f'quantity(self.{self.name}, "{flag}", {dim}, si)?'
+            elif self.rust.startswith("Vec<"):  # a list of any length, each with its unit
+                return (f'self.{self.name}.iter().map(|q| crate::args::flag_value(*q, "{flag}", '
+                        f'{dim}, si)).collect::<Result<_, _>>()?')
             else:
                 return f'crate::args::flag_value(self.{self.name}, "{flag}", {dim}, si)?'
         elif self.rust == "String" or self.rust.startswith("Vec<") or self.ty().startswith(

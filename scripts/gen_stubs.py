@@ -57,6 +57,7 @@ RUN = [
     ("fit", "fit"),
     ("fit_map", "fit_map"),
     ("thermal", "thermal"),
+    ("calibrate", "calibrate"),
 ]
 #: the studies run into a store through ``_afmdyn.run_stored`` (the library's
 #: ``study::stored::parse``) and their schema files

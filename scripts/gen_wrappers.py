@@ -87,6 +87,10 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "fm": ("fm", "_fm", "xr.Dataset", {}),
         "thermal": ("thermal", "_api", "xr.Dataset", {}),
+        "calibrate": ("calibrate", "_api", "xr.Dataset", {
+            "override": {"frequency": ("Optional[Sequence[float]]", "None"),
+                         "spectral_density": ("Optional[Sequence[float]]", "None"),
+                         "bands": ("Optional[Sequence[float]]", "None")}}),
         "peakforce": ("peakforce", "_peakforce", "xr.Dataset", {
             "omit": ("sweep",),
             "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),

@@ -248,6 +248,31 @@ Raises:
     },
 }
 
+WRAPPERS["calibrate"] = {
+    "summary": """\
+A lever's spring constant from its measured thermal spectrum (``afmdyn calibrate``; a probe is
+needed for its modes, their correction factors and, for Sader's method, its plan and fluid):
+each mode's peak fitted by a simple harmonic oscillator on a white floor, with standard errors;
+the static and each mode's effective spring constant by the thermal method (Butt & Jaschke
+1995, the model's correction factor) and by Sader's method (Sader, Chon & Mulvaney 1999;
+Lozano et al. 2010) and their agreement; the InvOLS of a force curve's contact slope. The
+spectrum is a CSV file ``psd`` (columns ``frequency``, ``psd``) or the arrays ``frequency`` and
+``spectral_density``.""",
+    "returns": """\
+Returns:
+    An ``xarray.Dataset`` over ``frequency`` (Hz) with ``psd`` and ``fitted`` (m²/Hz), and over
+    ``mode`` the ``modes_*`` variables (``modes_frequency`` Hz, ``modes_quality_factor``,
+    ``modes_spring_constant_thermal``, ``modes_spring_constant_sader``,
+    ``modes_static_spring_constant_thermal``, ``modes_static_spring_constant_sader`` N/m,
+    each with its ``…_standard_error``); attributes ``temperature`` (K) and ``summary`` (the
+    ``afmdyn calibrate --json`` document).""",
+    "raises": """\
+Raises:
+    ValueError: naming the option (``psd``, ``peaks``, ``bands``, ``invols``, ``volts``,
+        ``force_curve``, ``temperature``, ``spot``), the missing probe or the model
+        parameter.""",
+}
+
 WRAPPERS["thermal"] = {
     "summary": """\
 The free lever's thermal spectrum at ``temperature`` (``afmdyn thermal``; a probe is
@@ -604,7 +629,7 @@ Returns:
     },
 }
 
-AFM = ("observe", "approach", "bimodal", "resonance", "fm", "thermal", "peakforce", "fit", "fit_map", "image",
+AFM = ("observe", "approach", "bimodal", "resonance", "fm", "thermal", "calibrate", "peakforce", "fit", "fit_map", "image",
        "setpoint_study", "reconstruct")
 STARTS = ("attractors", "basins", "global_continuation")
 DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM + STARTS},

@@ -5,7 +5,7 @@
 
 use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{FitMapRequest, FitRequest, ThermalRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
+use afmdyn::request::{CalibrateRequest, FitMapRequest, FitRequest, ThermalRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`ImageRequest`]'s fields (generated from its schema).
@@ -251,6 +251,59 @@ impl ThermalFlags {
             spot: self.spot,
             temperature: self.temperature,
             to: quantity(self.to, "to", Dim::Frequency, si)?,
+        })
+    }
+}
+
+/// The flags of [`CalibrateRequest`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct CalibrateFlags {
+    /// `--psd`: the request's `psd`.
+    #[arg(long, required = true, value_name = "FILE.csv", help = "A CSV file with the columns frequency (Hz, increasing) and psd (the one-sided power spectral density, m²/Hz, or V²/Hz with --volts), read through the bounded reader (instead of the columns frequency and spectral_density).")]
+    pub psd: Option<String>,
+    /// `--signal`: the request's `signal`.
+    #[arg(long, value_parser = ["apparent-deflection", "deflection"], help = "What the spectrum measures: apparent-deflection (an optical lever's, the default) or deflection (the tip's, an interferometer's).")]
+    pub signal: Option<String>,
+    /// `--volts`: the request's `volts`.
+    #[arg(long, help = "Whether the PSD is the detector's, in V²/Hz: converted with --invols, or with the InvOLS of --force-curve.")]
+    pub volts: bool,
+    /// `--invols`: the request's `invols`.
+    #[arg(long, allow_negative_numbers = true, help = "The inverse optical lever sensitivity (m/V, > 0) that converts a PSD in V²/Hz.")]
+    pub invols: Option<f64>,
+    /// `--force-curve`: the request's `force_curve`.
+    #[arg(long, value_name = "FILE.csv", help = "A force curve on a hard surface: a CSV with the columns height (m, the piezo height, decreasing into the surface) and deflection (V), whose contact slope gives the InvOLS.")]
+    pub force_curve: Option<String>,
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
+    pub temperature: Option<f64>,
+    /// `--spot`: the request's `spot`.
+    #[arg(long, allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤ 1; default 1): the correction factors are the model's there.")]
+    pub spot: Option<f64>,
+    /// `--peaks`: the request's `peaks`.
+    #[arg(long, value_name = "N", help = "The number of peaks fitted, the modes from the first (1 to the probe's number of modes; default every mode of the probe whose peak lies in the spectrum).")]
+    pub peaks: Option<usize>,
+    /// `--bands`: the request's `bands`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "LO,HI,…", help = "The frequency bands searched for the modes' peaks, a pair lo, hi (Hz) per mode from the first: [lo1, hi1, lo2, hi2, …]; default from half to twice the probe's f_k, bounded by the geometric means with the neighbouring modes. With --probe a unit may follow (300kHz).")]
+    pub bands: Vec<Quantity>,
+}
+
+impl CalibrateFlags {
+    /// The [`CalibrateRequest`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`).
+    pub fn request(&self, si: bool) -> Result<CalibrateRequest, CliError> {
+        Ok(CalibrateRequest {
+            bands: self.bands.iter().map(|q| crate::args::flag_value(*q, "bands", Dim::Frequency, si)).collect::<Result<_, _>>()?,
+            force_curve: self.force_curve.clone(),
+            invols: self.invols,
+            peaks: self.peaks,
+            psd: self.psd.clone(),
+            signal: self.signal.as_deref().map(|s| named(s, "signal")).transpose()?,
+            spot: self.spot,
+            temperature: self.temperature,
+            volts: self.volts,
+            ..CalibrateRequest::default()
         })
     }
 }

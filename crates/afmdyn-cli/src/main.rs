@@ -31,6 +31,7 @@ mod args;
 mod cmd_analysis;
 mod cmd_approach;
 mod cmd_basins;
+mod cmd_calibrate;
 mod cmd_chart;
 mod cmd_fit;
 mod cmd_fit_map;
@@ -118,6 +119,9 @@ enum Command {
     /// The free lever's thermal spectrum: each mode's f, Q, k and share, the deflection's and
     /// the optical lever's PSDs
     Thermal(cmd_thermal::ThermalArgs),
+    /// A lever's spring constant from its measured thermal spectrum: each mode's f, Q and k by
+    /// the thermal and Sader's methods, with standard errors; the InvOLS of a force curve
+    Calibrate(cmd_calibrate::CalibrateArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
     /// AM-AFM image of a heterogeneous sample (ideal or PI feedback): height, phase, E_dis maps
@@ -147,6 +151,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Fit(a) => cmd_fit::fit(&a),
         Command::FitMap(a) => cmd_fit_map::fit_map(&a),
         Command::Thermal(a) => cmd_thermal::thermal(&a),
+        Command::Calibrate(a) => cmd_calibrate::calibrate(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
         Command::Image(a) => cmd_image::image_cmd(&a),
     }

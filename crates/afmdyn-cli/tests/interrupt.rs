@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 
 /// How a request kind is run from the command line.
 enum Case {
-    /// `afmdyn ARGS` runs it for seconds; `out`: the subcommand takes `--out`. `{fit}`, `{fm}`
-    /// and `{map}` stand for the data files [`data_files`] writes.
+    /// `afmdyn ARGS` runs it for seconds; `out`: the subcommand takes `--out`. `{fit}`, `{fm}`,
+    /// `{map}` and `{psd}` stand for the data files [`data_files`] writes.
     Long {
         args: &'static [&'static str],
         out: bool,
@@ -190,6 +190,16 @@ fn case(name: &str) -> Option<Case> {
             ],
             out: true,
         },
+        "calibrate" => Long {
+            args: &[
+                "calibrate",
+                "--probe",
+                "examples/probe-beam-dmt.toml",
+                "--psd",
+                "{psd}",
+            ],
+            out: true,
+        },
         _ => return None,
     })
 }
@@ -252,6 +262,15 @@ fn data_files(dir: &Path) {
         }
     }
     std::fs::write(dir.join("map.csv"), map).unwrap();
+    // a thermal spectrum of a million rows: the oscillator of Q = 2 at the beam's 300 kHz
+    let mut psd = String::from("frequency,psd\n");
+    for i in 0..rows {
+        let f = 10e3 + 730e3 * i as f64 / rows as f64;
+        let r = f / 300e3;
+        let s = 1e-27 / ((1.0 - r * r).powi(2) + r * r / 4.0) + 1e-30;
+        writeln!(psd, "{f:e},{s:e}").unwrap();
+    }
+    std::fs::write(dir.join("psd.csv"), psd).unwrap();
 }
 
 /// `afmdyn` with SIGINT at its default action in the child, whatever this process inherited
@@ -341,6 +360,7 @@ fn ctrl_c_ends_every_request_kind_within_a_second() {
                 "{fit}" => fit.display().to_string(),
                 "{fm}" => fm.display().to_string(),
                 "{map}" => map.display().to_string(),
+                "{psd}" => dir.path().join("psd.csv").display().to_string(),
                 a => a.to_string(),
             })
             .collect();

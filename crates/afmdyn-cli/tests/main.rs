@@ -9,6 +9,7 @@ mod approach;
 mod battery;
 mod bimodal;
 mod bounded_inputs;
+mod calibrate;
 mod chart;
 mod cli;
 mod fit_map;

@@ -157,6 +157,17 @@ LONG = {
     # a million frequencies of a twenty-mode beam (seconds)
     "thermal": ("", "afmdyn.thermal(probe=EX + '/probe-beam-dmt.toml', modes=20, "
                     "points=10**6, progress=p)"),
+    # a million rows of a broad (Q = 2) peak at the beam's 300 kHz: every row fitted (seconds)
+    "calibrate": (
+        """
+        import numpy as np
+        f = np.linspace(10e3, 740e3, 10**6)
+        r = f / 300e3
+        s = 1e-27 / ((1 - r * r) ** 2 + r * r / 4) + 1e-30
+        """,
+        "afmdyn.calibrate(probe=EX + '/probe-beam-dmt.toml', frequency=f, "
+        "spectral_density=s, progress=p)",
+    ),
 }
 
 

@@ -373,7 +373,7 @@ def test_every_request_has_a_schema() -> None:
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
          "approach", "resonance", "chart", "global_continuation", "basins", "reconstruct",
          "fm", "image", "image_scan", "image_options", "peakforce", "fit", "fit_map",
-         "thermal"]
+         "thermal", "calibrate"]
     )
 
 

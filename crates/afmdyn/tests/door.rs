@@ -416,8 +416,27 @@ fn case(name: &str) -> Option<Case> {
             long: Some(json!({"points": 1000000})),
             long_params: None,
         },
+        "calibrate" => Case {
+            probe: Some(BEAM),
+            sizes: [sho_spectrum(1000), sho_spectrum(100_000)],
+            long: Some(sho_spectrum(1_000_000)),
+            long_params: None,
+        },
         _ => return None,
     })
+}
+
+/// A measured thermal spectrum of `n` rows (`calibrate`): the oscillator of Q = 2 at the beam
+/// probe's first mode (300 kHz), its band the whole spectrum (a fit over every row).
+fn sho_spectrum(n: usize) -> serde_json::Value {
+    let f: Vec<f64> = (0..n).map(|i| 10e3 + 730e3 * i as f64 / n as f64).collect();
+    let s: Vec<f64> = (f.iter())
+        .map(|f| {
+            let r = f / 300e3;
+            1e-27 / ((1.0 - r * r).powi(2) + r * r / 4.0) + 1e-30
+        })
+        .collect();
+    serde_json::json!({"frequency": f, "spectral_density": s})
 }
 
 /// The model of a case: its probe, else the paper's parameters.

@@ -98,6 +98,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
             "thermal",
             schema::<afmdyn::request::ThermalRequest>("thermal"),
         ),
+        (
+            "calibrate",
+            schema::<afmdyn::request::CalibrateRequest>("calibrate"),
+        ),
     ]
 }
 

@@ -474,6 +474,24 @@ ThermalRequest = TypedDict(
     total=False,
 )
 
+CalibrateRequest = TypedDict(
+    "CalibrateRequest",
+    {
+        "bands": List[float],  # default []
+        "force_curve": Optional[str],  # default null
+        "frequency": List[float],  # default []
+        "invols": Optional[float],  # default null
+        "peaks": Optional[int],  # default null
+        "psd": Optional[str],  # default null
+        "signal": Optional[Literal["apparent-deflection", "deflection"]],  # default null
+        "spectral_density": List[float],  # default []
+        "spot": Optional[float],  # default null
+        "temperature": Optional[float],  # default null
+        "volts": bool,  # default false
+    },
+    total=False,
+)
+
 BifurcationRequest = TypedDict(
     "BifurcationRequest",
     {
@@ -690,6 +708,15 @@ def run(
 def run(
     name: Literal["thermal"],
     request: Optional[ThermalRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["calibrate"],
+    request: Optional[CalibrateRequest] = None,
     params: Optional[Params] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,

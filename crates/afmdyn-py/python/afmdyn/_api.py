@@ -165,6 +165,23 @@ def _finish_thermal(a: Args) -> xr.Dataset:
     return ds
 
 
+def _finish_calibrate(a: Args) -> xr.Dataset:
+    """A lever's calibration from its measured thermal spectrum (``afmdyn calibrate``): the
+    spectrum and the fitted oscillators over ``frequency``, each mode's estimates over ``mode``
+    (``modes_*`` variables); ``attrs["summary"]`` is the document."""
+    arrays = {k: [float(v) for v in a[k]] if a[k] is not None else []
+              for k in ("frequency", "spectral_density", "bands")}
+    p, probe = _params(a["params"], a["model"])
+    d = _door("calibrate", "calibrate", a["progress"], p, probe, _request(a, **arrays))
+    ds = _layout.dataset(d["datasets"]["spectrum"])
+    modes = _layout.dataset(d["datasets"]["modes"])
+    for name, var in modes.data_vars.items():
+        ds[f"modes_{name}"] = var
+    ds.attrs = {"title": "afmdyn calibrate", "summary": d["json"],
+                **{k: v for k, v in d["facts"].items() if isinstance(v, (int, float))}}
+    return ds
+
+
 def _curve(desc: str, a: Args) -> xr.Dataset:
     """Run a stepped-curve analysis (``approach``, ``bimodal``, ``resonance``) — in the command
     line's resumable store ``store`` when given — and return its dataset

@@ -33,6 +33,7 @@ __all__ = [
     "resonance",
     "fm",
     "thermal",
+    "calibrate",
     "peakforce",
     "fit",
     "fit_map",
@@ -698,6 +699,80 @@ def thermal(
             missing probe or the model parameter.
     """
     return _api._finish_thermal(locals())
+
+
+@_typed(si={"bands": "frequency"})
+def calibrate(
+    params: Optional[Params] = None,
+    /,
+    *,
+    bands: Optional[Sequence[float]] = None,
+    force_curve: Optional[str] = None,
+    frequency: Optional[Sequence[float]] = None,
+    invols: Optional[float] = None,
+    peaks: Optional[int] = None,
+    psd: Optional[str] = None,
+    signal: Optional[str] = None,
+    spectral_density: Optional[Sequence[float]] = None,
+    spot: Optional[float] = None,
+    temperature: Optional[float] = None,
+    volts: bool = False,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """A lever's spring constant from its measured thermal spectrum (``afmdyn calibrate``; a probe is
+    needed for its modes, their correction factors and, for Sader's method, its plan and fluid):
+    each mode's peak fitted by a simple harmonic oscillator on a white floor, with standard errors;
+    the static and each mode's effective spring constant by the thermal method (Butt & Jaschke
+    1995, the model's correction factor) and by Sader's method (Sader, Chon & Mulvaney 1999;
+    Lozano et al. 2010) and their agreement; the InvOLS of a force curve's contact slope. The
+    spectrum is a CSV file ``psd`` (columns ``frequency``, ``psd``) or the arrays ``frequency`` and
+    ``spectral_density``.
+
+    Args:
+        bands: The frequency bands searched for the modes' peaks, a pair lo, hi (Hz) per
+            mode from the first: ``[lo1, hi1, lo2, hi2, …]``; default from half to twice the
+            probe's f_k, bounded by the geometric means with the neighbouring modes.
+        force_curve: A force curve on a hard surface: a CSV with the columns ``height`` (m,
+            the piezo height, decreasing into the surface) and ``deflection`` (V), whose
+            contact slope gives the InvOLS.
+        frequency: The frequencies (Hz, > 0, increasing), when no ``psd`` file is given.
+        invols: The inverse optical lever sensitivity (m/V, > 0) that converts a PSD in
+            V²/Hz.
+        peaks: The number of peaks fitted, the modes from the first (1 to the probe's number
+            of modes; default every mode of the probe whose peak lies in the spectrum).
+        psd: A CSV file with the columns ``frequency`` (Hz, increasing) and ``psd`` (the
+            one-sided power spectral density, m²/Hz, or V²/Hz with ``volts``), read through
+            the bounded reader (instead of the columns ``frequency`` and
+            ``spectral_density``).
+        signal: What the spectrum measures: ``apparent-deflection`` (an optical lever's, the
+            default) or ``deflection`` (the tip's, an interferometer's).
+        spectral_density: The one-sided PSD at them (m²/Hz, or V²/Hz with ``volts``; > 0),
+            as many as ``frequency``.
+        spot: The optical lever's laser spot ξ_s, a fraction of the length from the base (0
+            < ξ_s ≤ 1; default 1): the correction factors are the model's there.
+        temperature: The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K
+            it warns (a value in °C?).
+        volts: Whether the PSD is the detector's, in V²/Hz: converted with ``invols``, or
+            with the InvOLS of ``force_curve``.
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        An ``xarray.Dataset`` over ``frequency`` (Hz) with ``psd`` and ``fitted`` (m²/Hz), and over
+        ``mode`` the ``modes_*`` variables (``modes_frequency`` Hz, ``modes_quality_factor``,
+        ``modes_spring_constant_thermal``, ``modes_spring_constant_sader``,
+        ``modes_static_spring_constant_thermal``, ``modes_static_spring_constant_sader`` N/m,
+        each with its ``…_standard_error``); attributes ``temperature`` (K) and ``summary`` (the
+        ``afmdyn calibrate --json`` document).
+
+    Raises:
+        ValueError: naming the option (``psd``, ``peaks``, ``bands``, ``invols``, ``volts``,
+            ``force_curve``, ``temperature``, ``spot``), the missing probe or the model
+            parameter.
+    """
+    return _api._finish_calibrate(locals())
 
 
 @_typed(si={"filter_cutoff": "frequency", "setpoint": "force", "z_c": "length"})

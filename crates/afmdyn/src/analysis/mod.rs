@@ -15,6 +15,7 @@ pub mod attractors;
 pub(crate) mod basin_entropy;
 pub mod basins;
 pub mod bifurcation;
+pub mod calibration;
 pub mod chart;
 pub mod continuation;
 pub mod converge;

@@ -325,6 +325,10 @@ pub struct Probe {
     /// analysis reads, which an analysis of the oscillating lever refuses. Empty otherwise.
     #[serde(skip)]
     pub assumed: Vec<String>,
+    /// The lever's plan, length L and width b (m), where the file gives it (the geometry, or
+    /// `[cantilever] length` and `width` with calibrated values): what Sader's method needs.
+    #[serde(skip)]
+    pub plan: Option<(f64, f64)>,
 }
 
 /// What a request uses of a probe ([`crate::request::run::Request::probe_needs`]).
@@ -518,6 +522,13 @@ enum Beam {
 }
 
 impl Beam {
+    /// The lever's plan (L, b) (m), where known.
+    fn plan(&self) -> Option<(f64, f64)> {
+        match self {
+            Beam::Calibrated { plan, .. } => *plan,
+            Beam::Geometry { width, si } => Some((si.length, *width)),
+        }
+    }
     /// The beam's tip-mass ratio α1: given, or from the geometry.
     fn tip_mass_ratio(&self) -> f64 {
         match self {

@@ -99,6 +99,7 @@ impl Probe {
             off_resonance: drive.off_resonance,
             sample_inputs: sample.inputs(),
             assumed: Vec::new(),
+            plan: cantilever.beam.plan(),
         })
     }
 

@@ -6,6 +6,7 @@
 //! the commands without a computation of their own (`modes --sweep fig3`, `units`,
 //! `cantilevers`) call theirs directly.
 
+pub(crate) mod calibrate;
 #[cfg(feature = "files")]
 pub(crate) mod census;
 #[cfg(feature = "files")]

@@ -29,6 +29,7 @@
 
 pub mod analyses;
 pub mod basins;
+pub mod calibrate;
 pub mod chart;
 pub(crate) mod costs;
 pub mod curves;
@@ -71,6 +72,7 @@ pub use analyses::{
     SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
 pub use basins::{BasinArrays, BasinsRequest};
+pub use calibrate::CalibrateRequest;
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
 pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]

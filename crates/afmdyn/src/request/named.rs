@@ -22,7 +22,7 @@ use serde::de::{Deserialize, Deserializer};
 use serde_json::Value;
 
 /// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 19] = [
+pub const NAMES: [&str; 20] = [
     "modes",
     "simulate",
     "converge",
@@ -42,6 +42,7 @@ pub const NAMES: [&str; 19] = [
     "fit",
     "fit_map",
     "thermal",
+    "calibrate",
 ];
 
 /// An analysis request parsed by name ([`parse`]): the request of its name, as data. Its
@@ -93,6 +94,8 @@ pub(crate) enum Parsed {
     FitMap(super::FitMapRequest),
     /// `thermal`.
     Thermal(super::ThermalRequest),
+    /// `calibrate`.
+    Calibrate(super::CalibrateRequest),
 }
 
 /// `$body` on the request `$r` of every variant of a [`NamedRequest`]'s `Parsed` but `simulate` (its
@@ -120,6 +123,7 @@ macro_rules! each_request {
             $crate::request::named::Parsed::Fit($r) => $body,
             $crate::request::named::Parsed::FitMap($r) => $body,
             $crate::request::named::Parsed::Thermal($r) => $body,
+            $crate::request::named::Parsed::Calibrate($r) => $body,
             $crate::request::named::Parsed::Simulate($s) => $simulate,
             $crate::request::named::Parsed::ReconstructDocument($f) => $document,
         }
@@ -196,6 +200,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "fit" => door(d, N::Fit),
         "fit_map" => door(d, N::FitMap),
         "thermal" => door(d, N::Thermal),
+        "calibrate" => door(d, N::Calibrate),
         _ => Ok(None),
     }
 }
@@ -228,6 +233,7 @@ pub fn default_request(name: &str) -> Option<Value> {
         "fit" => v::<super::FitRequest>(),
         "fit_map" => v::<super::FitMapRequest>(),
         "thermal" => v::<super::ThermalRequest>(),
+        "calibrate" => v::<super::CalibrateRequest>(),
         _ => None,
     }
 }

@@ -64,17 +64,53 @@ impl ThermalRequest {
 
     /// The warning of a temperature outside the typical range, naming the likely slip.
     pub fn warnings(&self) -> Vec<String> {
-        let t = self.temperature();
-        let (lo, hi) = TYPICAL_TEMPERATURE;
-        if (lo..=hi).contains(&t) {
-            return Vec::new();
-        }
-        vec![format!(
-            "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
-             in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
-            t + 273.15
-        )]
+        temperature_warnings(self.temperature())
     }
+}
+
+/// The warning of a temperature `t` (K) outside the typical range, naming the likely slip.
+pub(crate) fn temperature_warnings(t: f64) -> Vec<String> {
+    let (lo, hi) = TYPICAL_TEMPERATURE;
+    if (lo..=hi).contains(&t) {
+        return Vec::new();
+    }
+    vec![format!(
+        "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
+         in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
+        t + 273.15
+    )]
+}
+
+/// The checks of a temperature `t` (K) and a laser spot `spot` shared by the thermal
+/// requests: a probe, T in (0, 1500] K, 0 < spot ≤ 1.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `probe`, `temperature` or `spot`.
+pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), SimError> {
+    model.params.validate_fields()?;
+    if model.probe.is_none() {
+        return Err(bad(
+            "probe",
+            "missing",
+            "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
+        ));
+    }
+    let (lo, hi) = TEMPERATURE_RANGE;
+    if !(t > lo && t <= hi) {
+        return Err(bad(
+            "temperature",
+            crate::error::number(t),
+            "the temperature must be above absolute zero and at most 1500 K (K)",
+        ));
+    }
+    if !(spot > 0.0 && spot <= 1.0) {
+        return Err(bad(
+            "spot",
+            crate::error::number(spot),
+            "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1",
+        ));
+    }
+    Ok(())
 }
 
 fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimError {
@@ -84,31 +120,7 @@ fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimEr
 impl Request for ThermalRequest {
     const COST_ADVICE: &'static str = "ask for fewer points";
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        model.params.validate_fields()?;
-        if model.probe.is_none() {
-            return Err(bad(
-                "probe",
-                "missing",
-                "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
-            ));
-        }
-        let t = self.temperature();
-        let (lo, hi) = TEMPERATURE_RANGE;
-        if !(t > lo && t <= hi) {
-            return Err(bad(
-                "temperature",
-                crate::error::number(t),
-                "the temperature must be above absolute zero and at most 1500 K (K)",
-            ));
-        }
-        let spot = self.spot();
-        if !(spot > 0.0 && spot <= 1.0) {
-            return Err(bad(
-                "spot",
-                crate::error::number(spot),
-                "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1",
-            ));
-        }
+        check_thermal(model, self.temperature(), self.spot())?;
         if let Some(f) = self.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
             return Err(bad(
                 "to",

@@ -52,6 +52,7 @@
 
 pub(crate) mod analyses;
 pub mod basins;
+pub(crate) mod calibrate;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
