@@ -141,12 +141,21 @@ pub struct FitFlags {
     /// `--no-profiles`: the request's `profiles` false.
     #[arg(long, help = "Turns --profiles off (not given: the default).")]
     pub no_profiles: bool,
+    /// `--bandwidth`: the request's `bandwidth`.
+    #[arg(long, allow_hyphen_values = true, help = "The detection bandwidth B (Hz, > 0) of the thermal σ; default the Nyquist frequency of the time column, 1/(2Δt). With --probe a unit may follow (300kHz).")]
+    pub bandwidth: Option<Quantity>,
     /// `--bonded`: the request's `bonded`.
     #[arg(long, conflicts_with = "no_bonded", help = "Whether the sample is bonded to the substrate (glued; the default, true) or free to slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the sphere only). Used with --thickness.")]
     pub bonded: bool,
     /// `--no-bonded`: the request's `bonded` false.
     #[arg(long, help = "Turns --bonded off (not given: the default).")]
     pub no_bonded: bool,
+    /// `--detector-noise`: the request's `detector_noise`.
+    #[arg(long, allow_negative_numbers = true, help = "The detector's deflection noise floor n_d (m/√Hz, ≥ 0) of the thermal σ; default 0.")]
+    pub detector_noise: Option<f64>,
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500) of a force curve's thermal σ: when the data carry no sigma, each force's standard deviation is the lever's thermal force noise σ_F = k √(⟨z*²⟩_B + n_d² B), ⟨z*²⟩_B the optical lever's mean-square deflection below the --bandwidth B from the probe's thermal spectrum (afmdyn thermal, each mode as its oscillator) and n_d the --detector-noise: the free lever's (in contact with a sample of stiffness k_s the scatter about the fit grows to √(1 + k_s/k) times it, the lever and the sample in parallel seen through the tip position computed from the deflection). Default none: σ from the residuals.")]
+    pub temperature: Option<f64>,
     /// `--thickness`: the request's `thickness`.
     #[arg(long, allow_hyphen_values = true, help = "The sample's thickness h (m, > 0) above a rigid substrate: the Hertz law's force is corrected for the bottom effect (Dimitriadis et al., *Biophys. J.* 82 (2002) 2798 for the paraboloid and the sphere; Garcia & Garcia, *Biophys. J.* 114 (2018) 2923 for the cone, the pyramids and the flat punch, an incompressible sample, ν 0.45–0.5). Default none: a sample infinitely thick. With --probe a unit may follow (20nm).")]
     pub thickness: Option<Quantity>,
@@ -160,12 +169,15 @@ impl FitFlags {
     pub fn request(&self, si: bool) -> Result<FitRequest, CliError> {
         Ok(FitRequest {
             approach_rows: self.approach_rows,
+            bandwidth: quantity(self.bandwidth, "bandwidth", Dim::Frequency, si)?,
             bonded: either(self.bonded, self.no_bonded),
             data: self.data.clone(),
+            detector_noise: self.detector_noise,
             fit: self.fit.clone(),
             profiles: either(self.profiles, self.no_profiles),
             range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
             segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
+            temperature: self.temperature,
             thickness: quantity(self.thickness, "thickness", Dim::Length, si)?,
             ..FitRequest::default()
         })

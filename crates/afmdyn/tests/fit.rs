@@ -737,3 +737,74 @@ fn the_shapes_refusals_name_their_fields() {
         assert!(e.contains(word), "{tip}: {e}");
     }
 }
+
+/// The thermal σ (issue 79 item 4): without a σ column and with a `temperature`, each force's
+/// σ is the lever's thermal force noise. For this point-mass lever (k = 0.05 N/m, f₀ = 10 kHz,
+/// Q = 50) over 1 000 f₀ it is √(k_B T k) (equipartition; the oscillator's tail beyond,
+/// 2/(3πQ·10⁹)), over 100 Hz ≪ f₀ it is k √(2 k_B T B/(π k f₀ Q)) (the oscillator's PSD at
+/// zero frequency, 1e-4 for the rise to 0.01 f₀). A curve with the first of these noises fits
+/// with χ²/dof within 4 of its standard deviations of 1 over its baseline and the first 50 nm
+/// of indentation (deeper, the noise of the tip position computed from the force adds
+/// (1 + |∂F/∂x|/k)² to the scatter, as on an instrument), and the document names the σ. A
+/// bandwidth without a temperature, and a probe without the lever's resonance, are refused.
+#[test]
+fn a_thermal_sigma_is_the_levers_force_noise() {
+    use afmdyn::probe::ProbeNeeds;
+    let kt = 1.380_649e-23 * 295.0;
+    let full = (kt * K).sqrt();
+    let fit = |b: f64, noise: f64| {
+        let (h, f) = synthetic(1000, noise, 3);
+        let r = FitRequest {
+            temperature: Some(295.0),
+            bandwidth: Some(b),
+            range: Some([-50e-9, 1e-6]),
+            ..request(h, f, &[YOUNGS_MODULUS, "contact_point"])
+        };
+        run(&r, &probe(), &Progress::default()).expect("fit").json
+    };
+    let doc = fit(1e7, full);
+    let sigma = doc["sigma_thermal"].as_f64().unwrap();
+    assert!((sigma / full - 1.0).abs() < 1e-6, "{sigma} vs {full}");
+    let (chi2, dof) = (
+        doc["chi2_dof"].as_f64().unwrap(),
+        doc["dof"].as_f64().unwrap(),
+    );
+    assert!((chi2 - 1.0).abs() < 4.0 * (2.0 / dof).sqrt(), "{chi2}");
+    assert!(
+        doc["noise"].as_str().unwrap().contains("thermal"),
+        "{}",
+        doc["noise"]
+    );
+    let low = fit(100.0, 1e-13)["sigma_thermal"].as_f64().unwrap();
+    let want = K * (2.0 * kt * 100.0 / (std::f64::consts::PI * K * 10e3 * 50.0)).sqrt();
+    assert!((low / want - 1.0).abs() < 1e-4, "{low} vs {want}");
+    // refused: a bandwidth alone; the stand-ins of a quasi-static read
+    let (h, f) = synthetic(400, 1e-12, 3);
+    let alone = FitRequest {
+        bandwidth: Some(1e3),
+        ..request(h.clone(), f.clone(), &[YOUNGS_MODULUS])
+    };
+    let e = run(&alone, &probe(), &Progress::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bandwidth"), "{e}");
+    let text = "[cantilever]\nspring_constant = 0.05\n[tip]\nradius = 5e-6\n\
+                [sample]\nlaw = \"hertz\"\nyoungs_modulus = 10e3\npoisson_ratio = 0.5\n";
+    let p = Probe::parse_for(text, "k-tip-sample", ProbeNeeds::Static).expect("static read");
+    let minimal = Resolved {
+        params: p.params.clone(),
+        probe: Some(p),
+    };
+    let thermal = FitRequest {
+        temperature: Some(295.0),
+        bandwidth: Some(1e3),
+        ..request(h, f, &[YOUNGS_MODULUS])
+    };
+    let e = run(&thermal, &minimal, &Progress::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("temperature") && e.contains("resonance_frequency"),
+        "{e}"
+    );
+}

@@ -433,8 +433,10 @@ FitRequest = TypedDict(
     "FitRequest",
     {
         "approach_rows": Optional[int],  # default null
+        "bandwidth": Optional[float],  # default null
         "bonded": Optional[bool],  # default null
         "data": Optional[str],  # default null
+        "detector_noise": Optional[float],  # default null
         "fit": List[str],  # default ["sample.youngs_modulus", "contact_point"]
         "force": List[float],  # default []
         "height": List[float],  # default []
@@ -442,6 +444,7 @@ FitRequest = TypedDict(
         "range": Optional[List[float]],  # default null
         "segment": Optional[Literal["approach", "retract", "whole"]],  # default null
         "sigma": Optional[List[float]],  # default null
+        "temperature": Optional[float],  # default null
         "thickness": Optional[float],  # default null
         "time": List[float],  # default []
     },

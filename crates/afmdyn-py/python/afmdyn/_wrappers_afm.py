@@ -869,18 +869,21 @@ def peakforce(
     return _peakforce._finish_peakforce(locals())
 
 
-@_typed(si={"fit_range": "length", "thickness": "length"})
+@_typed(si={"bandwidth": "frequency", "fit_range": "length", "thickness": "length"})
 def fit(
     params: Optional[Params] = None,
     /,
     *,
     approach_rows: Optional[int] = None,
+    bandwidth: Optional[float] = None,
     bonded: Optional[bool] = None,
     data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
+    detector_noise: Optional[float] = None,
     fit: Optional[Sequence[str]] = None,
     profiles: Optional[bool] = None,
     fit_range: Optional[Tuple[float, float]] = None,
     segment: Optional[str] = None,
+    temperature: Optional[float] = None,
     thickness: Optional[float] = None,
     curve: int = 0,
     progress: ProgressArg = None,
@@ -899,6 +902,8 @@ def fit(
             reads from an instrument file); default up to the lowest piezo height,
             inclusive. 1 to the number of rows. For an afmformats curve the default is the
             instrument's segments.
+        bandwidth: The detection bandwidth B (Hz, > 0) of the thermal σ; default the Nyquist
+            frequency of the ``time`` column, 1/(2Δt).
         bonded: Whether the sample is bonded to the substrate (glued; the default, true) or
             free to slide on it (false: Dimitriadis et al.'s non-bonded series, of the
             paraboloid and the sphere only). Used with ``thickness``.
@@ -911,6 +916,8 @@ def fit(
             an ``afmformats`` force-distance object (a ``nanite.Indentation`` too), whose
             ``height (measured)`` (else ``height (piezo)``), ``force`` and ``time`` columns
             are taken.
+        detector_noise: The detector's deflection noise floor n_d (m/√Hz, ≥ 0) of the
+            thermal σ; default 0.
         fit: The parameters fitted, by their probe keys: ``sample.youngs_modulus``,
             ``tip.radius``, ``contact_point``, ``baseline``, and ``sample.hamaker`` (DMT) or
             ``sample.adhesion_energy`` (JKR); of the ``sls`` law ``sample.stiffness``,
@@ -938,6 +945,15 @@ def fit(
             default the whole segment.
         segment: The segment fitted: ``approach``, ``retract`` or ``whole``; default the
             approach, the whole curve for the ``sls`` law.
+        temperature: The temperature T (K, > 0 and ≤ 1500) of a force curve's thermal σ:
+            when the data carry no ``sigma``, each force's standard deviation is the lever's
+            thermal force noise σ_F = k √(⟨z*²⟩_B + n_d² B), ⟨z*²⟩_B the optical lever's
+            mean-square deflection below the ``bandwidth`` B from the probe's thermal
+            spectrum (``afmdyn thermal``, each mode as its oscillator) and n_d the
+            ``detector_noise``: the free lever's (in contact with a sample of stiffness k_s
+            the scatter about the fit grows to √(1 + k_s/k) times it, the lever and the
+            sample in parallel seen through the tip position computed from the deflection).
+            Default none: σ from the residuals.
         thickness: The sample's thickness h (m, > 0) above a rigid substrate: the Hertz
             law's force is corrected for the bottom effect (Dimitriadis et al., *Biophys.
             J.* 82 (2002) 2798 for the paraboloid and the sphere; Garcia & Garcia, *Biophys.

@@ -294,5 +294,46 @@ impl ComplexLu {
     }
 }
 
+/// The fraction of a mode's thermal motion below r = f/f_k: its oscillator's PSD
+/// ∝ 1/((1 − r²)² + r²/Q²) integrated from 0 to `r` over its integral to ∞, πQ/2 (an
+/// overdamped mode, `q` `None`, as Q = 1/2). Composite Simpson in θ, r = 1 + tan θ/(2Q) (the
+/// peak's Lorentzian made flat), 20 000 intervals: 1e-9 for Q from 0.5 to 10⁵.
+pub fn band_fraction(q: Option<f64>, r: f64) -> f64 {
+    let q = q.unwrap_or(0.5);
+    let h = 0.5 / q;
+    let (a, b) = ((-1.0 / h).atan(), ((r - 1.0) / h).atan());
+    let f = |t: f64| {
+        let x = 1.0 + h * t.tan();
+        let d = (1.0 - x * x).powi(2) + x * x / (q * q);
+        h / (t.cos().powi(2) * d)
+    };
+    let n = 20_000;
+    let step = (b - a) / n as f64;
+    let sum: f64 = (0..=n)
+        .map(|i| {
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            w * f(a + step * i as f64)
+        })
+        .sum();
+    (sum * step / 3.0 / (std::f64::consts::FRAC_PI_2 * q)).clamp(0.0, 1.0)
+}
+
+/// The optical lever's apparent mean-square deflection (m²) of the `modes` below `bandwidth`
+/// (Hz): each mode's ⟨z*_k²⟩ times its [`band_fraction`] (each mode taken as its oscillator).
+pub fn apparent_mean_square_in_band(modes: &[ThermalMode], bandwidth: f64) -> f64 {
+    (modes.iter())
+        .map(|m| {
+            m.mean_square_apparent_deflection
+                * band_fraction(m.quality_factor, bandwidth / m.frequency)
+        })
+        .sum()
+}
+
 #[cfg(test)]
 mod tests;

@@ -109,6 +109,21 @@ pub struct FitRequest {
     /// slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the
     /// sphere only). Used with `thickness`.
     pub bonded: Option<bool>,
+    /// The temperature T (K, > 0 and ≤ 1500) of a force curve's thermal σ: when the data carry
+    /// no `sigma`, each force's standard deviation is the lever's thermal force noise
+    /// σ_F = k √(⟨z*²⟩_B + n_d² B), ⟨z*²⟩_B the optical lever's mean-square deflection below
+    /// the `bandwidth` B from the probe's thermal spectrum (`afmdyn thermal`, each mode as its
+    /// oscillator) and n_d the `detector_noise`: the free lever's (in contact with a sample of
+    /// stiffness k_s the scatter about the fit grows to √(1 + k_s/k) times it, the lever and
+    /// the sample in parallel seen through the tip position computed from the deflection).
+    /// Default none: σ from the residuals.
+    pub temperature: Option<f64>,
+    /// The detection bandwidth B (Hz, > 0) of the thermal σ; default the Nyquist frequency of
+    /// the `time` column, 1/(2Δt).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+    pub bandwidth: Option<f64>,
+    /// The detector's deflection noise floor n_d (m/√Hz, ≥ 0) of the thermal σ; default 0.
+    pub detector_noise: Option<f64>,
 }
 
 impl Default for FitRequest {
@@ -126,6 +141,9 @@ impl Default for FitRequest {
             profiles: None,
             thickness: None,
             bonded: None,
+            temperature: None,
+            bandwidth: None,
+            detector_noise: None,
         }
     }
 }
@@ -295,6 +313,7 @@ impl FitRequest {
         if law == LawKind::Hertz {
             self.indenter(&inputs)?;
         }
+        self.check_noise(model)?;
         let names = force_curve::parameter_names_of(law, &inputs.tip_shape).unwrap_or_default();
         if law == LawKind::Jkr && self.segment == Some(FitSegment::Whole) {
             return Err(bad(
@@ -412,6 +431,64 @@ pub(crate) fn check_columns(
     Ok(())
 }
 
+impl FitRequest {
+    /// The thermal σ's options: T in (0, 1500] K, B > 0, n_d ≥ 0, neither of the latter
+    /// without T, and a probe that gives the lever's resonance and Q (not a quasi-static
+    /// read's stand-ins).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option.
+    fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
+        let Some(t) = self.temperature else {
+            return match (self.bandwidth, self.detector_noise) {
+                (None, None) => Ok(()),
+                (b, _) => Err(bad(
+                    if b.is_some() {
+                        "bandwidth"
+                    } else {
+                        "detector_noise"
+                    },
+                    "given without a temperature",
+                    "the bandwidth and the detector noise set the thermal σ: give the temperature"
+                        .into(),
+                )),
+            };
+        };
+        let (lo, hi) = super::thermal::TEMPERATURE_RANGE;
+        let number = crate::error::number;
+        if !(t > lo && t <= hi) {
+            return Err(bad(
+                "temperature",
+                number(t),
+                "above 0 K and at most 1500 K".into(),
+            ));
+        }
+        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
+            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)".into()));
+        }
+        if let Some(n) = self
+            .detector_noise
+            .filter(|n| !(n.is_finite() && *n >= 0.0))
+        {
+            return Err(bad(
+                "detector_noise",
+                number(n),
+                "finite and ≥ 0 (m/√Hz)".into(),
+            ));
+        }
+        match model.probe.as_ref().map(|p| &p.assumed) {
+            Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(
+                "temperature",
+                number(t),
+                "the thermal σ needs the lever's modes: give [cantilever] resonance_frequency \
+                 and quality_factor in the probe"
+                    .into(),
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
 impl Request for FitRequest {
     const COST_ADVICE: &'static str =
         "give fewer rows (an AM curve: fit fewer rows or parameters, or without profiles)";
@@ -426,6 +503,9 @@ impl Request for FitRequest {
                 .thickness
                 .map(|h| ("thickness", crate::error::number(h)))
                 .or(self.bonded.map(|b| ("bonded", b.to_string())))
+                .or(self
+                    .temperature
+                    .map(|t| ("temperature", crate::error::number(t))))
             {
                 return Err(bad(
                     name,

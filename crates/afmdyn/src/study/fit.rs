@@ -32,6 +32,45 @@ pub use super::fit_result::FitResult;
 use super::fit_result::{bounds, intervals_method};
 
 impl FitRequest {
+    /// The thermal force noise σ_F = k √(⟨z*²⟩_B + n_d² B) (N) at `temperature` (the request's
+    /// `temperature` docs): the probe's modes (`crate::analysis::thermal`) and its spring
+    /// constant k, B the `bandwidth` or the Nyquist frequency of the rows' `time`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `bandwidth` when neither is given; the thermal
+    /// spectrum's errors.
+    fn thermal_sigma(
+        &self,
+        model: &Resolved,
+        temperature: f64,
+        time: Option<&[f64]>,
+        progress: &Progress,
+    ) -> Result<f64, SimError> {
+        use crate::analysis::thermal::{
+            apparent_mean_square_in_band, thermal_spectrum, ModelUnits,
+        };
+        let probe = model.probe.as_ref().expect("checked");
+        let nyquist = time
+            .filter(|t| t.len() > 1)
+            .map(|t| 0.5 * (t.len() - 1) as f64 / (t[t.len() - 1] - t[0]));
+        let b = self.bandwidth.or(nyquist).ok_or_else(|| {
+            bad(
+                "bandwidth",
+                "missing",
+                "the thermal σ needs the detection bandwidth (Hz), or a time column".into(),
+            )
+        })?;
+        let units = ModelUnits {
+            length_m: probe.scales.length_m,
+            force_n: probe.scales.force_n,
+            time_s: probe.scales.time_s,
+        };
+        let s = thermal_spectrum(&model.params, units, temperature, 1.0, &[], progress)?;
+        let floor = self.detector_noise.unwrap_or(0.0).powi(2) * b;
+        let k = probe.calibration.spring_constant;
+        Ok(k * (apparent_mean_square_in_band(&s.modes, b) + floor).sqrt())
+    }
+
     /// The curve of `height` and `force` (and the sls law's `time`) preprocessed with the
     /// lever's spring constant `k`, its approach `approach_rows` long when given (the
     /// request's, or a map curve's segments).
@@ -350,6 +389,7 @@ impl FitRequest {
             outcome,
             data_warnings: data,
             dynamic: None,
+            thermal_sigma: None,
         })
     }
 }
@@ -378,6 +418,11 @@ impl Analysis for FitRequest {
         let law = self.check(model)?;
         let (height, force, sigma, time) = self.columns()?;
         let probe = model.probe.as_ref().expect("checked");
+        let thermal = match (&sigma, self.temperature) {
+            (None, Some(t)) => Some(self.thermal_sigma(model, t, time.as_deref(), progress)?),
+            _ => None,
+        };
+        let sigma = sigma.or(thermal.map(|s| vec![s; force.len()]));
         let curve = Curve {
             height: &height,
             force: &force,
@@ -387,7 +432,9 @@ impl Analysis for FitRequest {
             approach_rows: self.approach_rows,
         };
         let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
-        self.fit_curve(law, &probe.sample_inputs, curve, walk, progress)
+        let mut r = self.fit_curve(law, &probe.sample_inputs, curve, walk, progress)?;
+        r.thermal_sigma = thermal;
+        Ok(r)
     }
     fn report(&self, _: &Resolved, r: &FitResult) -> Result<Value, SimError> {
         Ok(document(self, r))
@@ -495,7 +542,19 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
         "chi2": o.chi2,
         "dof": o.dof,
         "chi2_dof": o.chi2_dof,
-        "noise": if o.noise_estimated { "noise estimated from residuals (no sigma column): χ²/dof is the force noise variance σ² (N²)" } else { "the sigma column (χ² in units of σ)" },
+        "noise": match (r.thermal_sigma, o.noise_estimated) {
+            (Some(s), _) => format!(
+                "the thermal σ_F = {} N at {} K (the probe's thermal spectrum below {}, detector \
+                 floor {} m/√Hz; χ² in units of σ)",
+                crate::error::number(s),
+                crate::error::number(request.temperature.unwrap_or(f64::NAN)),
+                request.bandwidth.map_or("the time column's Nyquist frequency".into(), |b| format!("{} Hz", crate::error::number(b))),
+                crate::error::number(request.detector_noise.unwrap_or(0.0)),
+            ),
+            (None, true) => "noise estimated from residuals (no sigma column): χ²/dof is the force noise variance σ² (N²)".into(),
+            (None, false) => "the sigma column (χ² in units of σ)".into(),
+        },
+        "sigma_thermal": r.thermal_sigma,
         "curve": {
             "tip_position": pick(&r.curve.tip_position),
             "force": pick(&r.curve.force),

@@ -123,6 +123,7 @@ pub(crate) fn execute(
         names,
         outcome,
         data_warnings: Vec::new(),
+        thermal_sigma: None,
         dynamic: Some(DynamicFit {
             data,
             channels,

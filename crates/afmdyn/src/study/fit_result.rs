@@ -55,6 +55,9 @@ pub struct FitResult {
     /// The dynamic fit's data and channels, when the data are an AM or FM curve
     /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
     pub dynamic: Option<DynamicFit>,
+    /// The thermal σ_F (N) each force was given, where the request's `temperature` set it
+    /// (the data carrying no σ).
+    pub thermal_sigma: Option<f64>,
 }
 
 /// The dynamic fit's part of a [`FitResult`].

@@ -200,3 +200,22 @@ fn the_kept_factorisation_is_nalgebras_solve() {
         }
     }
 }
+
+/// The oscillator's share below r: the whole of it far above the peak (1 − 2/(3πQr³) to
+/// leading order), 2r/(πQ) far below, and half of it at r = 1 for a sharp peak; for Q from 0.5
+/// (overdamped) to 10⁵.
+#[test]
+fn the_band_fraction_is_the_oscillators() {
+    for q in [0.5, 2.0, 400.0, 1e5] {
+        let far = band_fraction(Some(q), 1e3);
+        assert!(
+            (far - (1.0 - 2.0 / (3.0 * std::f64::consts::PI * q * 1e9))).abs() < 1e-8,
+            "{q}: {far}"
+        );
+        let low = band_fraction(Some(q), 1e-3);
+        let want = 2e-3 / (std::f64::consts::PI * q);
+        assert!((low / want - 1.0).abs() < 1e-5, "{q}: {low} vs {want}");
+    }
+    assert!((band_fraction(Some(1e5), 1.0) - 0.5).abs() < 1e-4);
+    assert_eq!(band_fraction(None, 1.0), band_fraction(Some(0.5), 1.0));
+}
