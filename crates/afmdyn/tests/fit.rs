@@ -792,7 +792,7 @@ fn a_thermal_sigma_is_the_levers_force_noise() {
                 [sample]\nlaw = \"hertz\"\nyoungs_modulus = 10e3\npoisson_ratio = 0.5\n";
     let p = Probe::parse_for(text, "k-tip-sample", ProbeNeeds::Static).expect("static read");
     let minimal = Resolved {
-        params: p.params.clone(),
+        params: p.params,
         probe: Some(p),
     };
     let thermal = FitRequest {
