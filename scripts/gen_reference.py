@@ -19,7 +19,10 @@ front ends already declare, so that no reference table is written by hand (issue
   and ``afmdyn.dask.__all__`` (read from the package's sources, not imported), grouped by the
   module that lists it.
 * ``messages.md``: the errors of the library's door (``SimError`` in
-  ``crates/afmdyn/src/error.rs``): each variant's message and its doc comment.
+  ``crates/afmdyn/src/error.rs``): each variant's message, its doc comment and the doc's
+  ``What to do:``; and its warnings: every ``warning!("code", "what to do", "message", …)`` of
+  ``crates/afmdyn/src`` (a warning pushed into a result's warnings without one stops the
+  generator).
 * ``layouts.md`` and ``layouts/{dynamics,curves,images}.md``: the variables of every analysis's result
   (their dims, unit, kind, meaning and the meanings of a code's values), from
   ``docs/schema/layouts/*.json`` (written and checked by ``crates/afmdyn/tests/layouts.rs`` from
@@ -401,21 +404,131 @@ def doc_text(doc: str) -> str:
     return re.sub(r"\[`([^`\]]+)`\](?:\([^)]*\))?", r"`\1`", doc)
 
 
+def todo_split(doc: str) -> Tuple[str, str]:
+    """(what it means, what to do) of a variant's doc comment: the part before and after its
+    ``What to do:``; a variant without one stops the generator."""
+    meaning, sep, todo = doc.partition("What to do:")
+    return meaning.strip(), todo.strip() if sep else ""
+
+
+#: the library's sources, whose ``warning!`` invocations the page lists
+LIBRARY = ROOT / "crates" / "afmdyn" / "src"
+#: one ``warning!("code", "what to do", "message", args…)``: its code, advice and message
+WARNING = re.compile(r'warning!\(\s*("(?:[^"\\]|\\.)*")\s*,\s*("(?:[^"\\]|\\.)*")\s*,\s*'
+                     r'("(?:[^"\\]|\\.)*")', re.S)
+#: a message pushed into a result's warnings, or made by a function whose name says warning:
+#: a string literal right after ``warnings.push(`` (or ``w.``, ``out.``), or after ``format!(``
+#: in such a function
+PUSHED = re.compile(r'\b(?:warnings|w|out)\.push\(\s*(?:format!\(\s*)?("(?:[^"\\]|\\.)*")',
+                    re.S)
+FORMATTED = re.compile(r'format!\(\s*("(?:[^"\\]|\\.)*")', re.S)
+#: files others are changing, whose free-form warnings wait for their code (listed on the page)
+UNDECLARED_OK = {"request/thermal.rs"}
+
+
+def literal(text: str) -> str:
+    """A Rust string literal's text: line continuations joined, ``\\"`` unescaped."""
+    return re.sub(r"\\\n\s*", "", text[1:-1]).replace('\\"', '"')
+
+
+def library_code(path: Path) -> str:
+    """A library source without its unit tests (the ``#[cfg(test)]`` module that ends a file)
+    and its comment lines."""
+    src = path.read_text().split("\n#[cfg(test)]\nmod tests", 1)[0]
+    return re.sub(r"^\s*//.*$", "", src, flags=re.M)
+
+
+def warning_functions(src: str) -> List[Tuple[int, int]]:
+    """The spans of the functions of ``src`` whose name says warning (``warnings``,
+    ``fallback_warning``, …): from the signature to the brace that closes it."""
+    spans = []
+    for m in re.finditer(r"^( *)(?:pub(?:\([^)]*\))? )?fn \w*warn\w*", src, re.M):
+        end = src.find("\n" + m.group(1) + "}", m.end())
+        spans.append((m.start(), len(src) if end < 0 else end))
+    return spans
+
+
+def library_warnings() -> Tuple[List[Dict[str, str]], List[Tuple[str, str]]]:
+    """Every ``warning!`` of the library (code, what to do, message template, file), sorted by
+    code, and the messages still pushed without one: (file, template). A repeated code, or a
+    message without one outside ``UNDECLARED_OK``, stops the generator."""
+    found: List[Dict[str, str]] = []
+    loose: List[Tuple[str, str]] = []
+    for path in sorted(LIBRARY.rglob("*.rs")):
+        rel = path.relative_to(LIBRARY).as_posix()
+        if rel.endswith("tests.rs") or "/tests/" in rel:
+            continue
+        src = library_code(path)
+        declared = []
+        for m in WARNING.finditer(src):
+            found.append({"code": literal(m.group(1)), "todo": literal(m.group(2)),
+                          "message": message(m.group(3).replace("\n", " ")), "file": rel})
+            declared.append(m.start(3))
+        spans = warning_functions(src)
+        candidates = [m.start(1) for m in PUSHED.finditer(src)]
+        # in such a function, a text bound by a `let` is a part of a message, not one
+        candidates += [m.start(1) for m in FORMATTED.finditer(src)
+                       if any(a <= m.start() < b for a, b in spans)
+                       and src.rfind("let ", 0, m.start()) <= src.rfind(";", 0, m.start())]
+        for start in sorted(set(candidates) - set(declared)):
+            text = literal(re.match(r'"(?:[^"\\]|\\.)*"', src[start:], re.S).group(0))  # type: ignore
+            # a fragment or a prefix added to another warning ("row 3: {w}") is no message
+            if len(re.sub(r"\{[^}]*\}", " ", text).split()) >= 6:
+                loose.append((rel, message('"' + text.replace('"', '\\"') + '"')))
+    codes = [w["code"] for w in found]
+    twice = sorted({c for c in codes if codes.count(c) > 1})
+    if twice:
+        sys.exit(f"gen_reference: warning codes used twice: {', '.join(twice)}")
+    stray_loose = [f"{f}: {m[:60]}" for f, m in loose if f not in UNDECLARED_OK]
+    if stray_loose:
+        sys.exit("gen_reference: warnings without a code and advice (write them with "
+                 "warning!(code, what to do, message)):\n  " + "\n  ".join(stray_loose))
+    return sorted(found, key=lambda w: w["code"]), loose
+
+
 def messages_page() -> str:
-    out = [header("the doc comments and messages of SimError, ParamError and UnitsError, "
-                  "crates/afmdyn/src/error.rs"),
-           "# Errors", "",
-           "Every error the library's door can give, as the library declares it: the variant, its "
-           "message (`{name}` stands for a value the message names, `…` for one it computes) "
-           "and what it means. The command line prints the message after `afmdyn: ` and exits 2 "
-           "for bad input, 1 for a failed run; Python raises `ValueError` for bad input and "
-           "`afmdyn.SimulationError` for a failed run."]
+    out = [header("the doc comments and messages of SimError, ParamError and UnitsError "
+                  "(crates/afmdyn/src/error.rs) and the library's `warning!` invocations "
+                  "(crates/afmdyn/src)"),
+           "# Errors and warnings", "",
+           "Every error and every warning the library's door can give, as the library declares "
+           "them: the message (`{name}` stands for a value the message names, `…` for one it "
+           "computes), what it means and what to do. The command line prints an error after "
+           "`afmdyn: ` and exits 2 for bad input, 1 for a failed run; Python raises `ValueError` "
+           "for bad input and `afmdyn.SimulationError` for a failed run. A warning does not stop "
+           "the run: it is in the `warnings` of the result's document (`--json`), the command "
+           "line prints it on stderr after `afmdyn: warning: `, and Python issues it as an "
+           "`afmdyn.AfmdynWarning`.", "", "## Errors"]
     for enum in ENUMS:
-        out += ["", f"## {enum}", "", doc_text(enum_doc(enum)), "",
-                "| Error | Message | What it means |", "|---|---|---|"]
+        out += ["", f"### {enum}", "", doc_text(enum_doc(enum)), "",
+                "| Error | Message | What it means | What to do |", "|---|---|---|---|"]
         for name, msg, doc in sim_errors(enum):
-            out.append(f"| `{name}` | {cell(msg)} | {cell(doc_text(doc))} |")
-    return "\n".join(out) + "\n"
+            meaning, todo = todo_split(doc_text(doc))
+            if not todo:
+                sys.exit(f"gen_reference: {enum}::{name} has no 'What to do:' in its doc comment")
+            out.append(f"| `{name}` | {cell(msg)} | {cell(meaning)} | {cell(todo)} |")
+    found, loose = library_warnings()
+    out += ["", "## Warnings", "",
+            "Each warning with its code (the `warning!` that makes it, in the file named under "
+            "`crates/afmdyn/src`), its message and what to do. A warning of a probe key outside "
+            "its typical range reads `[section].key = value (unit) is` followed by "
+            "`probe.unit-slip` or `probe.atypical`; a warning of one part of a result (a "
+            "material, a row of a fit, a value of a sweep) is prefixed by the part.", ""]
+    groups: Dict[str, List[Dict[str, str]]] = {}
+    for w in found:
+        groups.setdefault(w["code"].split(".")[0], []).append(w)
+    for group, ws in groups.items():
+        out += [f"### `{group}`", "", "| Code | Message | What to do | Made in |",
+                "|---|---|---|---|"]
+        out += [f"| `{w['code']}` | {cell(w['message'])} | {cell(w['todo'])} | `{w['file']}` |"
+                for w in ws]
+        out.append("")
+    if loose:
+        out += ["### Without a code yet", "",
+                "Warnings of files being changed elsewhere, not yet written with `warning!` "
+                "(so without advice):", "", "| Message | Made in |", "|---|---|"]
+        out += [f"| {cell(m)} | `{f}` |" for f, m in loose]
+    return "\n".join(out).rstrip("\n") + "\n"
 
 
 # --- layouts.md and layouts/*.md -------------------------------------------------------------
