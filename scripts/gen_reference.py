@@ -12,9 +12,10 @@ front ends already declare, so that no reference table is written by hand (issue
   ``crates/afmdyn-py/tests/test_reference.py`` runs the checkout's binary and fails when its help
   differs from the snapshot. ``--help-from BIN`` rewrites the snapshot from a binary.
 * ``probe-keys.md``: every probe-file key, with its unit, sign, physical and typical range, and
-  the contact laws whose ``[sample]`` takes it and the groups it sets, from
+  its default, the contact laws whose ``[sample]`` takes it and the groups it sets, from
   ``docs/schema/probe-keys.json`` (written and checked by ``crates/afmdyn/tests/schema.rs``
-  from the probe reader, ``probe::ranges::SI_RANGES`` and the law registry ``contact::LAWS``).
+  from the probe reader, ``probe::ranges::SI_RANGES``, ``probe::defaults::KEY_DEFAULTS`` and the
+  law registry ``contact::LAWS``).
 * ``python.md``: the Python API by Sphinx autodoc, one directive per name of ``afmdyn.__all__``
   and ``afmdyn.dask.__all__`` (read from the package's sources, not imported), grouped by the
   module that lists it.
@@ -306,16 +307,19 @@ def number(x: Optional[float]) -> str:
 def probe_keys_page() -> str:
     data = json.loads(PROBE_KEYS.read_text())
     out = [header("docs/schema/probe-keys.json (written by crates/afmdyn/tests/schema.rs from "
-                  "the probe reader, the library's range table and its law registry)"),
+                  "the probe reader, the library's range table, its defaults and its law registry)"),
            "# Probe keys", "",
            "Every key of a probe file (SI units), as the library reads it: its unit and what the "
            "reader checks (a number's sign or range, the names a name may take), the physical range outside which a value is refused (a unit slip "
            "rather than a measurement) and the typical range outside which it is accepted with a "
            "warning; for a `[sample]` key, the contact laws that take it and the dimensionless "
-           "groups of those laws it sets. A key without a unit holds a name or a list. The "
+           "groups of those laws it sets; and what a file without the key reads as (its "
+           "default, or `required`: where a numeric default is given the library's tests check "
+           "it against the reader). A key without a unit holds a name or a list. The "
            "`[feedback]` key is the image's sample file's (`afmdyn image --sample`).", "",
-           "| Key | Unit | The reader checks | Refused below | Refused above | Typical | Laws | Sets |",
-           "|---|---|---|---|---|---|---|---|"]
+           "| Key | Unit | The reader checks | Refused below | Refused above | Typical | Default "
+           "| Laws | Sets |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for k in data["keys"]:
         typical = (f"{number(k['typical'][0])} – {number(k['typical'][1])} "
                    f"({k['typical'][2]})") if k.get("typical") else ""
@@ -324,7 +328,8 @@ def probe_keys_page() -> str:
         hi = number(k.get("above")) + (of if k.get("above") is not None else "")
         laws = ", ".join(k["laws"]) if k["laws"] else ""
         out.append(f"| `{k['key']}` | {cell(k.get('unit') or '')} | {cell(k.get('must_be') or '')}"
-                   f" | {cell(lo)} | {cell(hi)} | {cell(typical)} | {cell(laws)} | "
+                   f" | {cell(lo)} | {cell(hi)} | {cell(typical)} | {cell(k['default'])} | "
+                   f"{cell(laws)} | "
                    f"{cell(', '.join(k['groups']))} |")
     out += ["", "## The `[sample]` keys of each law", "", "| Law | Keys |", "|---|---|"]
     out += [f"| `{law}` | {', '.join(f'`{k}`' for k in keys)} |"

@@ -309,6 +309,23 @@ fn probe_keys() -> Value {
             }
         }
     }
+    // each key's default (probe::defaults), one per key the reader knows
+    use afmdyn::probe::defaults::KEY_DEFAULTS;
+    for e in &mut out {
+        let key = e["key"].as_str().unwrap().to_string();
+        let d = KEY_DEFAULTS.iter().find(|d| d.0 == key);
+        e["default"] = json!(
+            d.unwrap_or_else(|| panic!("{key}: no KEY_DEFAULTS entry"))
+                .2
+        );
+    }
+    for d in KEY_DEFAULTS {
+        assert!(
+            out.iter().any(|e| e["key"] == d.0),
+            "{}: not a probe key",
+            d.0
+        );
+    }
     let laws: serde_json::Map<String, Value> = afmdyn::contact::LAWS
         .iter()
         .map(|l| (l.name.to_string(), json!(l.sample_keys)))
@@ -317,11 +334,57 @@ fn probe_keys() -> Value {
         "description": "Every key of a probe file, written by crates/afmdyn/tests/schema.rs from \
             the probe reader (its keys and the unit and sign it checks), its range table \
             (probe::ranges::SI_RANGES: refused outside [below, above], warned outside the \
-            typical range) and the law registry (contact::LAWS: the laws whose [sample] takes a \
-            key, the groups it sets).",
+            typical range), the law registry (contact::LAWS: the laws whose [sample] takes a \
+            key, the groups it sets) and its defaults (probe::defaults::KEY_DEFAULTS: the value \
+            a file without the key reads as).",
         "keys": out,
         "laws": laws,
     })
+}
+
+/// Every numeric default of `probe::defaults::KEY_DEFAULTS` is the reader's: a file of
+/// `examples/` that takes the key reads the same without it and with it set to the default.
+#[test]
+fn the_declared_defaults_are_the_readers() {
+    use afmdyn::probe::{defaults::KEY_DEFAULTS, Probe};
+    let examples = dir().join("../../../examples");
+    let read = |file: &str| -> toml::Table {
+        let text = std::fs::read_to_string(examples.join(file)).unwrap();
+        toml::from_str(&text).unwrap()
+    };
+    // an electrostatic sample: the DMT one with a bias
+    let mut electrostatic = read("probe-point-mass-dmt.toml");
+    let s = electrostatic["sample"].as_table_mut().unwrap();
+    s.insert("law".into(), "electrostatic".into());
+    s.insert("bias_voltage".into(), 1.0.into());
+    let mut checked = 0;
+    for (key, value, _) in KEY_DEFAULTS {
+        let Some(value) = value else { continue };
+        let (section, name) = key.split_once('.').unwrap();
+        let base = match *key {
+            "cantilever.tip_mass_ratio" => read("probe-beam-dmt.toml"),
+            "cantilever.tip_mass" | "sample.damping" => read("probe-geometry-hertz.toml"),
+            "sample.surface_tension" | "sample.contact_angle" => read("probe-capillary-humid.toml"),
+            "sample.contact_potential" => electrostatic.clone(),
+            _ => read("probe-point-mass-dmt.toml"),
+        };
+        let probe = |v: Option<f64>| {
+            let mut t = base.clone();
+            let s = t[section].as_table_mut().unwrap();
+            s.remove(name);
+            if let Some(v) = v {
+                s.insert(name.into(), v.into());
+            }
+            Probe::parse(&toml::to_string(&t).unwrap(), key).unwrap()
+        };
+        assert_eq!(
+            probe(None),
+            probe(Some(*value)),
+            "{key}: its default is not {value}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 9);
 }
 
 #[test]

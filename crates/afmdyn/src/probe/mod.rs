@@ -119,6 +119,7 @@
 //! a modulus of 4 Pa, a resonance at 300 Hz: read as a unit slip, with the reading meant), all
 //! listed in one [`ProbeError::Invalid`].
 
+pub mod defaults;
 mod medium;
 pub mod ranges;
 mod reader;
