@@ -29,11 +29,16 @@ front ends already declare, so that no reference table is written by hand (issue
   ``docs/schema/layouts/*.json`` (written and checked by ``crates/afmdyn/tests/layouts.rs`` from
   the library's result layouts, which the NetCDF files, the Python Datasets and the Dask stores
   are written from).
+* ``csv-files.md``: the columns of the command line's CSV files (``CSV_RUNS``), from
+  ``docs/reference/csv-files.snapshot.json``, the header of each file as small runs of the binary
+  write it (``--help-from BIN`` rewrites it too; ``test_reference.py`` compares it with the
+  binary), with each column's unit and meaning from the file's ``.npy.json`` or else the
+  variable of the same name in the analysis's layout.
 * ``index.md``: the toctree of these pages.
 
     python3 scripts/gen_reference.py                  # rewrite the pages
     python3 scripts/gen_reference.py --check          # exit 1 when a page is stale
-    python3 scripts/gen_reference.py --help-from BIN  # rewrite the help snapshot, then the pages
+    python3 scripts/gen_reference.py --help-from BIN  # rewrite the snapshots, then the pages
 
 ``scripts/gen_stubs.py`` runs it too (write and ``--check``).
 """
@@ -45,12 +50,14 @@ import json
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Callable, Dict, List, Optional, Tuple
 
 ROOT = Path(__file__).resolve().parent.parent
 REF = ROOT / "docs" / "reference"
 HELP = REF / "commands.help.txt"
+CSV_SNAPSHOT = REF / "csv-files.snapshot.json"
 PROBE_KEYS = ROOT / "docs" / "schema" / "probe-keys.json"
 PACKAGE = ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn"
 ERRORS = ROOT / "crates" / "afmdyn" / "src" / "error.rs"
@@ -307,7 +314,8 @@ def number(x: Optional[float]) -> str:
 def probe_keys_page() -> str:
     data = json.loads(PROBE_KEYS.read_text())
     out = [header("docs/schema/probe-keys.json (written by crates/afmdyn/tests/schema.rs from "
-                  "the probe reader, the library's range table, its defaults and its law registry)"),
+                  "the probe reader, the library's range table, its defaults and its law "
+                  "registry)"),
            "# Probe keys", "",
            "Every key of a probe file (SI units), as the library reads it: its unit and what the "
            "reader checks (a number's sign or range, the names a name may take), the physical range outside which a value is refused (a unit slip "
@@ -476,7 +484,8 @@ def library_warnings() -> Tuple[List[Dict[str, str]], List[Tuple[str, str]]]:
                        if any(a <= m.start() < b for a, b in spans)
                        and src.rfind("let ", 0, m.start()) <= src.rfind(";", 0, m.start())]
         for start in sorted(set(candidates) - set(declared)):
-            text = literal(re.match(r'"(?:[^"\\]|\\.)*"', src[start:], re.S).group(0))  # type: ignore
+            lit = re.match(r'"(?:[^"\\]|\\.)*"', src[start:], re.S)
+            text = literal(lit.group(0))  # type: ignore[union-attr]
             # a fragment or a prefix added to another warning ("row 3: {w}") is no message
             if len(re.sub(r"\{[^}]*\}", " ", text).split()) >= 6:
                 loose.append((rel, message('"' + text.replace('"', '\\"') + '"')))
@@ -722,6 +731,107 @@ def layout_pages() -> Dict[str, str]:
     return pages
 
 
+# --- csv-files.md ----------------------------------------------------------------------------
+
+P = "examples/probe-point-mass-dmt.toml"
+#: the small runs whose CSV files the page lists: (the file, the command's arguments, the
+#: analysis whose layout (docs/schema/layouts) names the columns); a file written by two runs is
+#: listed under its name and the second run's last flag
+CSV_RUNS = [
+    ("approach.csv", ["approach", "--probe", P, "--points", "5", "--files", "data"], "approach"),
+    ("approach.csv", ["approach", "--probe", P, "--points", "5", "--files", "data",
+                      "--dforce-columns"], "approach"),
+    ("resonance.csv", ["resonance", "--probe", P, "--points", "5", "--files", "data"],
+     "resonance"),
+    ("bimodal.csv", ["bimodal", "--probe", "examples/probe-bimodal.toml", "--points", "4",
+                     "--files", "data"], "bimodal"),
+    ("fm.csv", ["fm", "--probe", P, "--from", "14e-9", "--to", "9.5e-9", "--points", "4",
+                "--files", "data"], "fm"),
+    ("reconstruct.csv", ["reconstruct", "--fm", "examples/fm-vdw.csv", "--spring-constant", "40",
+                         "--resonance-frequency", "300kHz", "--amplitude", "10nm", "--files",
+                         "data"], "reconstruct"),
+    ("chart.csv", ["chart", "--x-steps", "2", "--y-steps", "2", "--starts", "2", "--threads",
+                   "1"], "chart"),
+    # (an attractor's file is a trajectory: the variables of simulate's layout)
+    ("attractor-1.csv", ["attractors", "--omega", "2.6", "--samples", "8"], "simulate"),
+    ("converge.csv", ["converge"], "converge"),
+]
+
+
+def csv_snapshot(run: Callable[[List[str]], None]) -> str:
+    """The snapshot of the CSV files the binary that ``run`` (arguments, run in the
+    repository's root) writes for ``CSV_RUNS``: per file the command, its header's columns and,
+    where the command writes one, the columns (name, unit, meaning) of its ``.npy.json``."""
+    out: Dict[str, dict] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, (name, args, _) in enumerate(CSV_RUNS):
+            where = Path(tmp) / str(k)
+            run([*args, "--out", str(where)])
+            entry = {"command": "afmdyn " + " ".join(args),
+                     "columns": (where / name).read_text().split("\n", 1)[0].split(",")}
+            npy = where / (name[:-len(".csv")] + ".npy.json")
+            if npy.exists():
+                entry["npy"] = json.loads(npy.read_text())["columns"]
+            out[csv_label(name, args)] = entry
+    return json.dumps(out, indent=2, ensure_ascii=False) + "\n"
+
+
+def csv_label(name: str, args: List[str]) -> str:
+    """The name of a run's file on the page: the file's, with the run's last flag when an
+    earlier run writes the same file (``approach.csv --dforce-columns``)."""
+    first = next(a for n, a, _ in CSV_RUNS if n == name)
+    return name if args == first else f"{name} {args[-1]}"
+
+
+def csv_page() -> str:
+    snapshot = json.loads(CSV_SNAPSHOT.read_text())
+    files = layouts()
+    out = [header("docs/reference/csv-files.snapshot.json, the columns of the files of "
+                  "small runs of the binary (crates/afmdyn-py/tests/test_reference.py compares "
+                  "it with the binary), and the units and meanings the library declares for "
+                  "them: the `.npy.json` of a table written with one, else the variable of "
+                  "the same name in the analysis's layout"),
+           "# CSV files", "",
+           "The columns of each CSV file of the command line, as a small run of each command "
+           "writes them, with their unit and meaning as the library declares them: from the "
+           "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
+           "one, else from the variable of the same name in the analysis's "
+           "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
+           "without a probe, and under one where that differs). A column the library declares "
+           "neither way has no unit or meaning here: "
+           "the page of the command's outputs says what it holds.", ""]
+    for name, args, analysis in CSV_RUNS:
+        label = csv_label(name, args)
+        entry = snapshot[label]
+        npy = {c["name"]: c for c in entry.get("npy", [])}
+        variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
+        for variant, data in reversed(files.get(analysis, [])):
+            # (an attractor's trajectory is in the model's units: not simulate's under a probe)
+            if variant not in (None, "si") or (variant == "si" and analysis != args[0]):
+                continue
+            for ds in data["datasets"]:
+                for v in ds["variables"]:
+                    base, si = variables.get(v["name"], (v, None))
+                    variables[v["name"]] = (base, v) if variant == "si" else (v, si)
+        out += [f"## `{label}`", "", f"Written by `{entry['command']}`"
+                + (" (units as in this run: SI under its probe)." if npy else "."), "",
+                "| Column | Unit | Meaning |", "|---|---|---|"]
+        for c in entry["columns"]:
+            if c in npy:
+                unit, what = npy[c]["unit"], npy[c]["meaning"]
+            elif c in variables:
+                base, si = variables[c]
+                unit = base["units"] or "1"
+                if si is not None and si["units"] != base["units"]:
+                    unit += f" ({si['units']} under a probe)"
+                what = meaning(base)
+            else:
+                unit, what = "", ""
+            out.append(f"| `{c}` | {cell(unit) or '–'} | {cell(what)} |")
+        out.append("")
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
 # --- index.md and main ---------------------------------------------------------------------
 
 #: the pages of the reference, in the toctree's order
@@ -731,6 +841,7 @@ PAGES: Dict[str, Callable[[], str]] = {
     "python": python_page,
     "messages": messages_page,
     "layouts": lambda: "",
+    "csv-files": csv_page,
 }
 
 
@@ -788,6 +899,8 @@ def main(argv: List[str]) -> int:
         binary = argv[argv.index("--help-from") + 1]
         HELP.write_text(help_snapshot(lambda args: subprocess.run(
             [binary, *args], capture_output=True, text=True, check=True).stdout))
+        CSV_SNAPSHOT.write_text(csv_snapshot(lambda args: subprocess.run(
+            [binary, *args], capture_output=True, text=True, check=True, cwd=ROOT) and None))
     return write_or_check(generate(), "--check" in argv, "scripts/gen_reference.py")
 
 
