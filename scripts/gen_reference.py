@@ -58,6 +58,7 @@ ROOT = Path(__file__).resolve().parent.parent
 REF = ROOT / "docs" / "reference"
 HELP = REF / "commands.help.txt"
 CSV_SNAPSHOT = REF / "csv-files.snapshot.json"
+CSV_COLUMNS = ROOT / "docs" / "schema" / "csv-columns.json"
 PROBE_KEYS = ROOT / "docs" / "schema" / "probe-keys.json"
 PACKAGE = ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn"
 ERRORS = ROOT / "crates" / "afmdyn" / "src" / "error.rs"
@@ -785,17 +786,20 @@ def csv_label(name: str, args: List[str]) -> str:
 
 def csv_page() -> str:
     snapshot = json.loads(CSV_SNAPSHOT.read_text())
+    declared = json.loads(CSV_COLUMNS.read_text())
     files = layouts()
     out = [header("docs/reference/csv-files.snapshot.json, the columns of the files of "
                   "small runs of the binary (crates/afmdyn-py/tests/test_reference.py compares "
                   "it with the binary), and the units and meanings the library declares for "
-                  "them: the `.npy.json` of a table written with one, else the variable of "
-                  "the same name in the analysis's layout"),
+                  "them: the `.npy.json` of a table written with one, the file's columns in "
+                  "docs/schema/csv-columns.json, else the variable of the same name in the "
+                  "analysis's layout"),
            "# CSV files", "",
            "The columns of each CSV file of the command line, as a small run of each command "
            "writes them, with their unit and meaning as the library declares them: from the "
            "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
-           "one, else from the variable of the same name in the analysis's "
+           "one, or the library's table of the file's columns (`chart.csv`: "
+           "`request::chart::CSV_COLUMNS`), else from the variable of the same name in the analysis's "
            "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
            "without a probe, and under one where that differs). A column the library declares "
            "neither way has no unit or meaning here: "
@@ -804,6 +808,7 @@ def csv_page() -> str:
         label = csv_label(name, args)
         entry = snapshot[label]
         npy = {c["name"]: c for c in entry.get("npy", [])}
+        npy.update({c["name"]: c for c in declared.get(name, [])})
         variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
         for variant, data in reversed(files.get(analysis, [])):
             # (an attractor's trajectory is in the model's units: not simulate's under a probe)
@@ -814,7 +819,7 @@ def csv_page() -> str:
                     base, si = variables.get(v["name"], (v, None))
                     variables[v["name"]] = (base, v) if variant == "si" else (v, si)
         out += [f"## `{label}`", "", f"Written by `{entry['command']}`"
-                + (" (units as in this run: SI under its probe)." if npy else "."), "",
+                + (" (units as in this run: SI under its probe)." if entry.get("npy") else "."), "",
                 "| Column | Unit | Meaning |", "|---|---|---|"]
         for c in entry["columns"]:
             if c in npy:

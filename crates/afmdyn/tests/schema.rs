@@ -389,15 +389,34 @@ fn the_declared_defaults_are_the_readers() {
 
 #[test]
 fn probe_keys_match_the_committed_file() {
-    let path = dir().join("../probe-keys.json");
-    let text = serde_json::to_string_pretty(&probe_keys()).unwrap() + "\n";
+    committed("probe-keys.json", &probe_keys());
+}
+
+/// The columns the library declares for a CSV file that has no `.npy.json` beside it
+/// (`docs/schema/csv-columns.json`, which `scripts/gen_reference.py` shows in the book's CSV
+/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]).
+#[test]
+fn csv_columns_match_the_committed_file() {
+    let columns = |c: &[(&str, &str, &str)]| -> Vec<Value> {
+        c.iter()
+            .map(|(name, unit, meaning)| serde_json::json!({"name": name, "unit": unit, "meaning": meaning}))
+            .collect()
+    };
+    let chart = columns(&afmdyn::request::chart::CSV_COLUMNS);
+    committed("csv-columns.json", &serde_json::json!({"chart.csv": chart}));
+}
+
+/// `value` is the committed `docs/schema/<name>` (`AFMDYN_WRITE_SCHEMA=1` writes it).
+fn committed(name: &str, value: &Value) {
+    let path = dir().join("..").join(name);
+    let text = serde_json::to_string_pretty(value).unwrap() + "\n";
     if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
         std::fs::write(&path, &text).unwrap();
     }
     assert_eq!(
         std::fs::read_to_string(&path).ok().as_deref(),
         Some(text.as_str()),
-        "docs/schema/probe-keys.json differs from the library; regenerate with \
+        "docs/schema/{name} differs from the library; regenerate with \
          AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::schema::"
     );
 }
