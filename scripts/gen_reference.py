@@ -798,8 +798,8 @@ def csv_page() -> str:
            "The columns of each CSV file of the command line, as a small run of each command "
            "writes them, with their unit and meaning as the library declares them: from the "
            "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
-           "one, or the library's table of the file's columns (`chart.csv`: "
-           "`request::chart::CSV_COLUMNS`), else from the variable of the same name in the analysis's "
+           "one, or the library's table of the file's columns (`chart.csv`, `converge.csv`; "
+           "docs/schema/csv-columns.json), else from the variable of the same name in the analysis's "
            "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
            "without a probe, and under one where that differs). A column the library declares "
            "neither way has no unit or meaning here: "
@@ -809,6 +809,14 @@ def csv_page() -> str:
         entry = snapshot[label]
         npy = {c["name"]: c for c in entry.get("npy", [])}
         npy.update({c["name"]: c for c in declared.get(name, [])})
+        # a declared name with `{N}` stands for the names with a number there
+        for c in list(entry["columns"]):
+            for d in declared.get(name, []):
+                pattern = re.escape(d["name"]).replace(r"\{N\}", r"(\d+)")
+                m = re.fullmatch(pattern, c) if "{N}" in d["name"] else None
+                if m:
+                    npy[c] = {"unit": d["unit"],
+                              "meaning": re.sub(r"\bN\b", m.group(1), d["meaning"])}
         variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
         for variant, data in reversed(files.get(analysis, [])):
             # (an attractor's trajectory is in the model's units: not simulate's under a probe)

@@ -394,7 +394,8 @@ fn probe_keys_match_the_committed_file() {
 
 /// The columns the library declares for a CSV file that has no `.npy.json` beside it
 /// (`docs/schema/csv-columns.json`, which `scripts/gen_reference.py` shows in the book's CSV
-/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]).
+/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]) and `converge.csv`'s
+/// (`{N}` in a name stands for a number).
 #[test]
 fn csv_columns_match_the_committed_file() {
     let columns = |c: &[(&str, &str, &str)]| -> Vec<Value> {
@@ -403,7 +404,11 @@ fn csv_columns_match_the_committed_file() {
             .collect()
     };
     let chart = columns(&afmdyn::request::chart::CSV_COLUMNS);
-    committed("csv-columns.json", &serde_json::json!({"chart.csv": chart}));
+    let converge = columns(&afmdyn::report::present::converge::COLUMNS);
+    committed(
+        "csv-columns.json",
+        &serde_json::json!({"chart.csv": chart, "converge.csv": converge}),
+    );
 }
 
 /// `value` is the committed `docs/schema/<name>` (`AFMDYN_WRITE_SCHEMA=1` writes it).
