@@ -12,24 +12,33 @@ front ends already declare, so that no reference table is written by hand (issue
   ``crates/afmdyn-py/tests/test_reference.py`` runs the checkout's binary and fails when its help
   differs from the snapshot. ``--help-from BIN`` rewrites the snapshot from a binary.
 * ``probe-keys.md``: every probe-file key, with its unit, sign, physical and typical range, and
-  the contact laws whose ``[sample]`` takes it and the groups it sets, from
+  its default, the contact laws whose ``[sample]`` takes it and the groups it sets, from
   ``docs/schema/probe-keys.json`` (written and checked by ``crates/afmdyn/tests/schema.rs``
-  from the probe reader, ``probe::ranges::SI_RANGES`` and the law registry ``contact::LAWS``).
+  from the probe reader, ``probe::ranges::SI_RANGES``, ``probe::defaults::KEY_DEFAULTS`` and the
+  law registry ``contact::LAWS``).
 * ``python.md``: the Python API by Sphinx autodoc, one directive per name of ``afmdyn.__all__``
   and ``afmdyn.dask.__all__`` (read from the package's sources, not imported), grouped by the
   module that lists it.
 * ``messages.md``: the errors of the library's door (``SimError`` in
-  ``crates/afmdyn/src/error.rs``): each variant's message and its doc comment.
+  ``crates/afmdyn/src/error.rs``): each variant's message, its doc comment and the doc's
+  ``What to do:``; and its warnings: every ``warning!("code", "what to do", "message", …)`` of
+  ``crates/afmdyn/src`` (a warning pushed into a result's warnings without one stops the
+  generator).
 * ``layouts.md`` and ``layouts/{dynamics,curves,images}.md``: the variables of every analysis's result
   (their dims, unit, kind, meaning and the meanings of a code's values), from
   ``docs/schema/layouts/*.json`` (written and checked by ``crates/afmdyn/tests/layouts.rs`` from
   the library's result layouts, which the NetCDF files, the Python Datasets and the Dask stores
   are written from).
+* ``csv-files.md``: the columns of the command line's CSV files (``CSV_RUNS``), from
+  ``docs/reference/csv-files.snapshot.json``, the header of each file as small runs of the binary
+  write it (``--help-from BIN`` rewrites it too; ``test_reference.py`` compares it with the
+  binary), with each column's unit and meaning from the file's ``.npy.json`` or else the
+  variable of the same name in the analysis's layout.
 * ``index.md``: the toctree of these pages.
 
     python3 scripts/gen_reference.py                  # rewrite the pages
     python3 scripts/gen_reference.py --check          # exit 1 when a page is stale
-    python3 scripts/gen_reference.py --help-from BIN  # rewrite the help snapshot, then the pages
+    python3 scripts/gen_reference.py --help-from BIN  # rewrite the snapshots, then the pages
 
 ``scripts/gen_stubs.py`` runs it too (write and ``--check``).
 """
@@ -41,12 +50,15 @@ import json
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Callable, Dict, List, Optional, Tuple
 
 ROOT = Path(__file__).resolve().parent.parent
 REF = ROOT / "docs" / "reference"
 HELP = REF / "commands.help.txt"
+CSV_SNAPSHOT = REF / "csv-files.snapshot.json"
+CSV_COLUMNS = ROOT / "docs" / "schema" / "csv-columns.json"
 PROBE_KEYS = ROOT / "docs" / "schema" / "probe-keys.json"
 PACKAGE = ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn"
 ERRORS = ROOT / "crates" / "afmdyn" / "src" / "error.rs"
@@ -303,16 +315,20 @@ def number(x: Optional[float]) -> str:
 def probe_keys_page() -> str:
     data = json.loads(PROBE_KEYS.read_text())
     out = [header("docs/schema/probe-keys.json (written by crates/afmdyn/tests/schema.rs from "
-                  "the probe reader, the library's range table and its law registry)"),
+                  "the probe reader, the library's range table, its defaults and its law "
+                  "registry)"),
            "# Probe keys", "",
            "Every key of a probe file (SI units), as the library reads it: its unit and what the "
            "reader checks (a number's sign or range, the names a name may take), the physical range outside which a value is refused (a unit slip "
            "rather than a measurement) and the typical range outside which it is accepted with a "
            "warning; for a `[sample]` key, the contact laws that take it and the dimensionless "
-           "groups of those laws it sets. A key without a unit holds a name or a list. The "
+           "groups of those laws it sets; and what a file without the key reads as (its "
+           "default, or `required`: where a numeric default is given the library's tests check "
+           "it against the reader). A key without a unit holds a name or a list. The "
            "`[feedback]` key is the image's sample file's (`afmdyn image --sample`).", "",
-           "| Key | Unit | The reader checks | Refused below | Refused above | Typical | Laws | Sets |",
-           "|---|---|---|---|---|---|---|---|"]
+           "| Key | Unit | The reader checks | Refused below | Refused above | Typical | Default "
+           "| Laws | Sets |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for k in data["keys"]:
         typical = (f"{number(k['typical'][0])} – {number(k['typical'][1])} "
                    f"({k['typical'][2]})") if k.get("typical") else ""
@@ -321,7 +337,8 @@ def probe_keys_page() -> str:
         hi = number(k.get("above")) + (of if k.get("above") is not None else "")
         laws = ", ".join(k["laws"]) if k["laws"] else ""
         out.append(f"| `{k['key']}` | {cell(k.get('unit') or '')} | {cell(k.get('must_be') or '')}"
-                   f" | {cell(lo)} | {cell(hi)} | {cell(typical)} | {cell(laws)} | "
+                   f" | {cell(lo)} | {cell(hi)} | {cell(typical)} | {cell(k['default'])} | "
+                   f"{cell(laws)} | "
                    f"{cell(', '.join(k['groups']))} |")
     out += ["", "## The `[sample]` keys of each law", "", "| Law | Keys |", "|---|---|"]
     out += [f"| `{law}` | {', '.join(f'`{k}`' for k in keys)} |"
@@ -401,21 +418,132 @@ def doc_text(doc: str) -> str:
     return re.sub(r"\[`([^`\]]+)`\](?:\([^)]*\))?", r"`\1`", doc)
 
 
+def todo_split(doc: str) -> Tuple[str, str]:
+    """(what it means, what to do) of a variant's doc comment: the part before and after its
+    ``What to do:``; a variant without one stops the generator."""
+    meaning, sep, todo = doc.partition("What to do:")
+    return meaning.strip(), todo.strip() if sep else ""
+
+
+#: the library's sources, whose ``warning!`` invocations the page lists
+LIBRARY = ROOT / "crates" / "afmdyn" / "src"
+#: one ``warning!("code", "what to do", "message", args…)``: its code, advice and message
+WARNING = re.compile(r'warning!\(\s*("(?:[^"\\]|\\.)*")\s*,\s*("(?:[^"\\]|\\.)*")\s*,\s*'
+                     r'("(?:[^"\\]|\\.)*")', re.S)
+#: a message pushed into a result's warnings, or made by a function whose name says warning:
+#: a string literal right after ``warnings.push(`` (or ``w.``, ``out.``), or after ``format!(``
+#: in such a function
+PUSHED = re.compile(r'\b(?:warnings|w|out)\.push\(\s*(?:format!\(\s*)?("(?:[^"\\]|\\.)*")',
+                    re.S)
+FORMATTED = re.compile(r'format!\(\s*("(?:[^"\\]|\\.)*")', re.S)
+#: files others are changing, whose free-form warnings wait for their code (listed on the page)
+UNDECLARED_OK = {"request/thermal.rs"}
+
+
+def literal(text: str) -> str:
+    """A Rust string literal's text: line continuations joined, ``\\"`` unescaped."""
+    return re.sub(r"\\\n\s*", "", text[1:-1]).replace('\\"', '"')
+
+
+def library_code(path: Path) -> str:
+    """A library source without its unit tests (the ``#[cfg(test)]`` module that ends a file)
+    and its comment lines."""
+    src = path.read_text().split("\n#[cfg(test)]\nmod tests", 1)[0]
+    return re.sub(r"^\s*//.*$", "", src, flags=re.M)
+
+
+def warning_functions(src: str) -> List[Tuple[int, int]]:
+    """The spans of the functions of ``src`` whose name says warning (``warnings``,
+    ``fallback_warning``, …): from the signature to the brace that closes it."""
+    spans = []
+    for m in re.finditer(r"^( *)(?:pub(?:\([^)]*\))? )?fn \w*warn\w*", src, re.M):
+        end = src.find("\n" + m.group(1) + "}", m.end())
+        spans.append((m.start(), len(src) if end < 0 else end))
+    return spans
+
+
+def library_warnings() -> Tuple[List[Dict[str, str]], List[Tuple[str, str]]]:
+    """Every ``warning!`` of the library (code, what to do, message template, file), sorted by
+    code, and the messages still pushed without one: (file, template). A repeated code, or a
+    message without one outside ``UNDECLARED_OK``, stops the generator."""
+    found: List[Dict[str, str]] = []
+    loose: List[Tuple[str, str]] = []
+    for path in sorted(LIBRARY.rglob("*.rs")):
+        rel = path.relative_to(LIBRARY).as_posix()
+        if rel.endswith("tests.rs") or "/tests/" in rel:
+            continue
+        src = library_code(path)
+        declared = []
+        for m in WARNING.finditer(src):
+            found.append({"code": literal(m.group(1)), "todo": literal(m.group(2)),
+                          "message": message(m.group(3).replace("\n", " ")), "file": rel})
+            declared.append(m.start(3))
+        spans = warning_functions(src)
+        candidates = [m.start(1) for m in PUSHED.finditer(src)]
+        # in such a function, a text bound by a `let` is a part of a message, not one
+        candidates += [m.start(1) for m in FORMATTED.finditer(src)
+                       if any(a <= m.start() < b for a, b in spans)
+                       and src.rfind("let ", 0, m.start()) <= src.rfind(";", 0, m.start())]
+        for start in sorted(set(candidates) - set(declared)):
+            lit = re.match(r'"(?:[^"\\]|\\.)*"', src[start:], re.S)
+            text = literal(lit.group(0))  # type: ignore[union-attr]
+            # a fragment or a prefix added to another warning ("row 3: {w}") is no message
+            if len(re.sub(r"\{[^}]*\}", " ", text).split()) >= 6:
+                loose.append((rel, message('"' + text.replace('"', '\\"') + '"')))
+    codes = [w["code"] for w in found]
+    twice = sorted({c for c in codes if codes.count(c) > 1})
+    if twice:
+        sys.exit(f"gen_reference: warning codes used twice: {', '.join(twice)}")
+    stray_loose = [f"{f}: {m[:60]}" for f, m in loose if f not in UNDECLARED_OK]
+    if stray_loose:
+        sys.exit("gen_reference: warnings without a code and advice (write them with "
+                 "warning!(code, what to do, message)):\n  " + "\n  ".join(stray_loose))
+    return sorted(found, key=lambda w: w["code"]), loose
+
+
 def messages_page() -> str:
-    out = [header("the doc comments and messages of SimError, ParamError and UnitsError, "
-                  "crates/afmdyn/src/error.rs"),
-           "# Errors", "",
-           "Every error the library's door can give, as the library declares it: the variant, its "
-           "message (`{name}` stands for a value the message names, `…` for one it computes) "
-           "and what it means. The command line prints the message after `afmdyn: ` and exits 2 "
-           "for bad input, 1 for a failed run; Python raises `ValueError` for bad input and "
-           "`afmdyn.SimulationError` for a failed run."]
+    out = [header("the doc comments and messages of SimError, ParamError and UnitsError "
+                  "(crates/afmdyn/src/error.rs) and the library's `warning!` invocations "
+                  "(crates/afmdyn/src)"),
+           "# Errors and warnings", "",
+           "Every error and every warning the library's door can give, as the library declares "
+           "them: the message (`{name}` stands for a value the message names, `…` for one it "
+           "computes), what it means and what to do. The command line prints an error after "
+           "`afmdyn: ` and exits 2 for bad input, 1 for a failed run; Python raises `ValueError` "
+           "for bad input and `afmdyn.SimulationError` for a failed run. A warning does not stop "
+           "the run: it is in the `warnings` of the result's document (`--json`), the command "
+           "line prints it on stderr after `afmdyn: warning: `, and Python issues it as an "
+           "`afmdyn.AfmdynWarning`.", "", "## Errors"]
     for enum in ENUMS:
-        out += ["", f"## {enum}", "", doc_text(enum_doc(enum)), "",
-                "| Error | Message | What it means |", "|---|---|---|"]
+        out += ["", f"### {enum}", "", doc_text(enum_doc(enum)), "",
+                "| Error | Message | What it means | What to do |", "|---|---|---|---|"]
         for name, msg, doc in sim_errors(enum):
-            out.append(f"| `{name}` | {cell(msg)} | {cell(doc_text(doc))} |")
-    return "\n".join(out) + "\n"
+            meaning, todo = todo_split(doc_text(doc))
+            if not todo:
+                sys.exit(f"gen_reference: {enum}::{name} has no 'What to do:' in its doc comment")
+            out.append(f"| `{name}` | {cell(msg)} | {cell(meaning)} | {cell(todo)} |")
+    found, loose = library_warnings()
+    out += ["", "## Warnings", "",
+            "Each warning with its code (the `warning!` that makes it, in the file named under "
+            "`crates/afmdyn/src`), its message and what to do. A warning of a probe key outside "
+            "its typical range reads `[section].key = value (unit) is` followed by "
+            "`probe.unit-slip` or `probe.atypical`; a warning of one part of a result (a "
+            "material, a row of a fit, a value of a sweep) is prefixed by the part.", ""]
+    groups: Dict[str, List[Dict[str, str]]] = {}
+    for w in found:
+        groups.setdefault(w["code"].split(".")[0], []).append(w)
+    for group, ws in groups.items():
+        out += [f"### `{group}`", "", "| Code | Message | What to do | Made in |",
+                "|---|---|---|---|"]
+        out += [f"| `{w['code']}` | {cell(w['message'])} | {cell(w['todo'])} | `{w['file']}` |"
+                for w in ws]
+        out.append("")
+    if loose:
+        out += ["### Without a code yet", "",
+                "Warnings of files being changed elsewhere, not yet written with `warning!` "
+                "(so without advice):", "", "| Message | Made in |", "|---|---|"]
+        out += [f"| {cell(m)} | `{f}` |" for f, m in loose]
+    return "\n".join(out).rstrip("\n") + "\n"
 
 
 # --- layouts.md and layouts/*.md -------------------------------------------------------------
@@ -604,6 +732,119 @@ def layout_pages() -> Dict[str, str]:
     return pages
 
 
+# --- csv-files.md ----------------------------------------------------------------------------
+
+P = "examples/probe-point-mass-dmt.toml"
+#: the small runs whose CSV files the page lists: (the file, the command's arguments, the
+#: analysis whose layout (docs/schema/layouts) names the columns); a file written by two runs is
+#: listed under its name and the second run's last flag
+CSV_RUNS = [
+    ("approach.csv", ["approach", "--probe", P, "--points", "5", "--files", "data"], "approach"),
+    ("approach.csv", ["approach", "--probe", P, "--points", "5", "--files", "data",
+                      "--dforce-columns"], "approach"),
+    ("resonance.csv", ["resonance", "--probe", P, "--points", "5", "--files", "data"],
+     "resonance"),
+    ("bimodal.csv", ["bimodal", "--probe", "examples/probe-bimodal.toml", "--points", "4",
+                     "--files", "data"], "bimodal"),
+    ("fm.csv", ["fm", "--probe", P, "--from", "14e-9", "--to", "9.5e-9", "--points", "4",
+                "--files", "data"], "fm"),
+    ("reconstruct.csv", ["reconstruct", "--fm", "examples/fm-vdw.csv", "--spring-constant", "40",
+                         "--resonance-frequency", "300kHz", "--amplitude", "10nm", "--files",
+                         "data"], "reconstruct"),
+    ("chart.csv", ["chart", "--x-steps", "2", "--y-steps", "2", "--starts", "2", "--threads",
+                   "1"], "chart"),
+    # (an attractor's file is a trajectory: the variables of simulate's layout)
+    ("attractor-1.csv", ["attractors", "--omega", "2.6", "--samples", "8"], "simulate"),
+    ("converge.csv", ["converge"], "converge"),
+]
+
+
+def csv_snapshot(run: Callable[[List[str]], None]) -> str:
+    """The snapshot of the CSV files the binary that ``run`` (arguments, run in the
+    repository's root) writes for ``CSV_RUNS``: per file the command, its header's columns and,
+    where the command writes one, the columns (name, unit, meaning) of its ``.npy.json``."""
+    out: Dict[str, dict] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, (name, args, _) in enumerate(CSV_RUNS):
+            where = Path(tmp) / str(k)
+            run([*args, "--out", str(where)])
+            entry = {"command": "afmdyn " + " ".join(args),
+                     "columns": (where / name).read_text().split("\n", 1)[0].split(",")}
+            npy = where / (name[:-len(".csv")] + ".npy.json")
+            if npy.exists():
+                entry["npy"] = json.loads(npy.read_text())["columns"]
+            out[csv_label(name, args)] = entry
+    return json.dumps(out, indent=2, ensure_ascii=False) + "\n"
+
+
+def csv_label(name: str, args: List[str]) -> str:
+    """The name of a run's file on the page: the file's, with the run's last flag when an
+    earlier run writes the same file (``approach.csv --dforce-columns``)."""
+    first = next(a for n, a, _ in CSV_RUNS if n == name)
+    return name if args == first else f"{name} {args[-1]}"
+
+
+def csv_page() -> str:
+    snapshot = json.loads(CSV_SNAPSHOT.read_text())
+    declared = json.loads(CSV_COLUMNS.read_text())
+    files = layouts()
+    out = [header("docs/reference/csv-files.snapshot.json, the columns of the files of "
+                  "small runs of the binary (crates/afmdyn-py/tests/test_reference.py compares "
+                  "it with the binary), and the units and meanings the library declares for "
+                  "them: the `.npy.json` of a table written with one, the file's columns in "
+                  "docs/schema/csv-columns.json, else the variable of the same name in the "
+                  "analysis's layout"),
+           "# CSV files", "",
+           "The columns of each CSV file of the command line, as a small run of each command "
+           "writes them, with their unit and meaning as the library declares them: from the "
+           "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
+           "one, or the library's table of the file's columns (`chart.csv`, `converge.csv`; "
+           "docs/schema/csv-columns.json), else from the variable of the same name in the analysis's "
+           "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
+           "without a probe, and under one where that differs). A column the library declares "
+           "neither way has no unit or meaning here: "
+           "the page of the command's outputs says what it holds.", ""]
+    for name, args, analysis in CSV_RUNS:
+        label = csv_label(name, args)
+        entry = snapshot[label]
+        npy = {c["name"]: c for c in entry.get("npy", [])}
+        npy.update({c["name"]: c for c in declared.get(name, [])})
+        # a declared name with `{N}` stands for the names with a number there
+        for c in list(entry["columns"]):
+            for d in declared.get(name, []):
+                pattern = re.escape(d["name"]).replace(r"\{N\}", r"(\d+)")
+                m = re.fullmatch(pattern, c) if "{N}" in d["name"] else None
+                if m:
+                    npy[c] = {"unit": d["unit"],
+                              "meaning": re.sub(r"\bN\b", m.group(1), d["meaning"])}
+        variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
+        for variant, data in reversed(files.get(analysis, [])):
+            # (an attractor's trajectory is in the model's units: not simulate's under a probe)
+            if variant not in (None, "si") or (variant == "si" and analysis != args[0]):
+                continue
+            for ds in data["datasets"]:
+                for v in ds["variables"]:
+                    base, si = variables.get(v["name"], (v, None))
+                    variables[v["name"]] = (base, v) if variant == "si" else (v, si)
+        out += [f"## `{label}`", "", f"Written by `{entry['command']}`"
+                + (" (units as in this run: SI under its probe)." if entry.get("npy") else "."), "",
+                "| Column | Unit | Meaning |", "|---|---|---|"]
+        for c in entry["columns"]:
+            if c in npy:
+                unit, what = npy[c]["unit"], npy[c]["meaning"]
+            elif c in variables:
+                base, si = variables[c]
+                unit = base["units"] or "1"
+                if si is not None and si["units"] != base["units"]:
+                    unit += f" ({si['units']} under a probe)"
+                what = meaning(base)
+            else:
+                unit, what = "", ""
+            out.append(f"| `{c}` | {cell(unit) or '–'} | {cell(what)} |")
+        out.append("")
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
 # --- index.md and main ---------------------------------------------------------------------
 
 #: the pages of the reference, in the toctree's order
@@ -613,6 +854,7 @@ PAGES: Dict[str, Callable[[], str]] = {
     "python": python_page,
     "messages": messages_page,
     "layouts": lambda: "",
+    "csv-files": csv_page,
 }
 
 
@@ -670,6 +912,8 @@ def main(argv: List[str]) -> int:
         binary = argv[argv.index("--help-from") + 1]
         HELP.write_text(help_snapshot(lambda args: subprocess.run(
             [binary, *args], capture_output=True, text=True, check=True).stdout))
+        CSV_SNAPSHOT.write_text(csv_snapshot(lambda args: subprocess.run(
+            [binary, *args], capture_output=True, text=True, check=True, cwd=ROOT) and None))
     return write_or_check(generate(), "--check" in argv, "scripts/gen_reference.py")
 
 

@@ -234,7 +234,10 @@ pub(crate) fn calibration_warnings(root: &toml::Table) -> Vec<String> {
             } else {
                 (1.0 / ratio, "below")
             };
-            out.push(format!(
+            out.push(warning!(
+                "probe.off-nominal",
+                "Check that the probe file is for this lever; keep the value if it is \
+                 your calibration.",
                 "[cantilever].{key} = {v} {unit} is {factor:.1}× {side} {}'s nominal \
                  {nominal} {unit} (the maker's spread is a factor of {spread}): the probe's \
                  value is used, as a calibration is; check that the probe file is for this lever",

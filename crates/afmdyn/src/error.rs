@@ -9,9 +9,13 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
     /// The number of Galerkin modes N is outside 1..=20.
+    ///
+    /// What to do: give `modes` between 1 and 20.
     #[error("modes = {0}: the number of Galerkin modes N must be an integer in 1..=20")]
     Modes(usize),
     /// A non-negative coefficient (α1, α2, α3, α4, α6) is negative or not finite.
+    ///
+    /// What to do: give the coefficient a finite value ≥ 0.
     #[error("{name} = {}: must be finite and >= 0", number(*value))]
     NonNegative {
         /// Field name with its paper symbol, e.g. `alpha4 (contact stiffness α4)`.
@@ -20,12 +24,18 @@ pub enum ParamError {
         value: f64,
     },
     /// The gap α5 is not finite.
+    ///
+    /// What to do: give a finite gap (`alpha5`, or `z_c` with a probe).
     #[error("alpha5 (gap α5) = {}: must be a finite number", number(*.0))]
     Gap(f64),
     /// The drive frequency Ω is not finite or not positive.
+    ///
+    /// What to do: give a finite drive frequency > 0.
     #[error("omega (drive frequency Ω) = {}: must be finite and > 0", number(*.0))]
     Omega(f64),
     /// A group given for a law it does not belong to.
+    ///
+    /// What to do: set `contact_law` to the law the group belongs to, or leave the group out.
     #[error("{group} is a group of the {owner} law, not of contact_law = {law} (set contact_law = {owner})")]
     Group {
         /// The group, e.g. `restitution`.
@@ -36,6 +46,9 @@ pub enum ParamError {
         law: &'static str,
     },
     /// A group of the tip–sample law (see [`crate::contact::ContactLaw`]) is out of range.
+    ///
+    /// What to do: give the group a value in the range the message names (the law's page in
+    /// the book gives each group's meaning).
     #[error("{name} = {}: must satisfy {range}", number(*value))]
     Law {
         /// The group's name with its symbol.
@@ -47,6 +60,9 @@ pub enum ParamError {
     },
     /// A finite value beyond the range where the numerics are meaningful (see the limits in
     /// [`crate::params`]).
+    ///
+    /// What to do: give a value inside the range the message names; the reason says why the
+    /// numerics need it.
     #[error("{name} = {}: must lie in {range} ({reason})", number(*value))]
     Magnitude {
         /// Field name with its paper symbol.
@@ -59,6 +75,8 @@ pub enum ParamError {
         reason: &'static str,
     },
     /// A parameter the structural model does not allow (see [`crate::params::Structure`]).
+    ///
+    /// What to do: give the value the message names as allowed for this structural model.
     #[error("{name}: got {}", number(*value))]
     Structure {
         /// Field and the allowed value.
@@ -72,6 +90,8 @@ pub enum ParamError {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum UnitsError {
     /// A quantity that must be finite and strictly positive is not.
+    ///
+    /// What to do: give a finite value > 0 in the unit the message names.
     #[error("{name} = {}: must be finite and > 0 ({unit})", number(*value))]
     Positive {
         /// Field name.
@@ -82,6 +102,8 @@ pub enum UnitsError {
         unit: &'static str,
     },
     /// A quantity that must be finite and non-negative is not.
+    ///
+    /// What to do: give a finite value ≥ 0 in the unit the message names.
     #[error("{name} = {}: must be finite and >= 0 ({unit})", number(*value))]
     NonNegative {
         /// Field name.
@@ -92,6 +114,9 @@ pub enum UnitsError {
         unit: &'static str,
     },
     /// A Poisson ratio outside (-1, 0.5].
+    ///
+    /// What to do: give a Poisson ratio in (-1, 0.5] (0.3 for most solids, 0.5 for an
+    /// incompressible one).
     #[error("{name} = {}: a Poisson ratio must lie in (-1, 0.5]", number(*value))]
     Poisson {
         /// Field name.
@@ -100,6 +125,8 @@ pub enum UnitsError {
         value: f64,
     },
     /// A quantity that must be finite is not.
+    ///
+    /// What to do: give a finite number in the unit the message names.
     #[error("{name} = {}: must be a finite number ({unit})", number(*value))]
     Finite {
         /// Field name.
@@ -110,9 +137,13 @@ pub enum UnitsError {
         unit: &'static str,
     },
     /// Two mutually exclusive inputs were both given, or neither.
+    ///
+    /// What to do: give exactly one of the inputs the message names.
     #[error("{0}")]
     Choice(String),
     /// The derived dimensionless set is invalid.
+    ///
+    /// What to do: see the error it wraps (ParamError).
     #[error(transparent)]
     Params(#[from] ParamError),
 }
@@ -182,12 +213,19 @@ pub(crate) fn io_kind_message(kind: std::io::ErrorKind) -> String {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SimError {
     /// Invalid model parameters.
+    ///
+    /// What to do: see the error it wraps (ParamError).
     #[error(transparent)]
     Params(#[from] ParamError),
     /// A physical (SI) input out of range ([`crate::units`], [`crate::hydro`]).
+    ///
+    /// What to do: see the error it wraps (UnitsError).
     #[error(transparent)]
     Units(#[from] UnitsError),
     /// A state vector has the wrong length.
+    ///
+    /// What to do: give as many values as the message expects (N for positions, 2N for a
+    /// state of N modes).
     #[error("{name}: expected {expected} values, got {got}")]
     StateLength {
         /// Which input.
@@ -198,6 +236,8 @@ pub enum SimError {
         got: usize,
     },
     /// A state component or a time is NaN or infinite.
+    ///
+    /// What to do: give a finite number.
     #[error("{name} = {}: must be a finite number", number(*value))]
     NotFinite {
         /// Which input.
@@ -207,9 +247,15 @@ pub enum SimError {
     },
     /// A probe file (or a chart's probe with one of its values set) that does not resolve:
     /// the probe reader's message.
+    ///
+    /// What to do: correct the probe file (or the value set) as the message says; the probe
+    /// keys' reference gives each key's unit and ranges.
     #[error("{0}")]
     Probe(String),
     /// A run length, count or tolerance is out of range.
+    ///
+    /// What to do: give a value in the range the message names (each flag's and keyword's
+    /// range is in the commands' and the Python reference).
     #[error("{name} = {}: {allowed}", number_text(value))]
     OutOfRange {
         /// Which input.
@@ -220,6 +266,9 @@ pub enum SimError {
         allowed: std::borrow::Cow<'static, str>,
     },
     /// Repeated switchings with vanishing intervals (chattering / sliding).
+    ///
+    /// What to do: the contact grazes or slides there; integrate more finely (more steps per
+    /// period, or the adaptive integrator), or move the gap or amplitude off the grazing.
     #[error(
         "chattering at tau = {tau}: {count} switchings within {window:e} of dimensionless time"
     )]
@@ -232,6 +281,9 @@ pub enum SimError {
         window: f64,
     },
     /// The state grew beyond any physical bound (a diverging integration).
+    ///
+    /// What to do: integrate more finely (more steps per period, or an adaptive
+    /// integrator), or check the parameters for a physically impossible combination.
     #[error("diverged at tau = {tau}: |z| = {norm:e}")]
     Diverged {
         /// Time of divergence.
@@ -240,6 +292,9 @@ pub enum SimError {
         norm: f64,
     },
     /// Newton's method (shooting or continuation) did not converge.
+    ///
+    /// What to do: start nearer the solution (another start or a smaller continuation
+    /// step), or check that the orbit exists at these parameters (`simulate`).
     #[error("{what} did not converge: residual {residual:e} after {iterations} iterations")]
     NoConvergence {
         /// Which solver.
@@ -254,6 +309,9 @@ pub enum SimError {
     /// `periods`, and Newton from the motion's states found no period-1 orbit either — the
     /// motion is not periodic within `max_period` (a chaotic one, or the taps and missed taps
     /// of a grazing JKR contact, docs/contact-laws.md).
+    ///
+    /// What to do: give the period, another start or more `max_periods`; or take the motion
+    /// itself (`simulate`) or its time average (an approach curve).
     #[error(
         "no periodic orbit found: the motion from this start did not repeat with a period of at \
          most {max_period} drive periods within {periods} periods, and Newton from its states \
@@ -271,6 +329,8 @@ pub enum SimError {
         residual: f64,
     },
     /// The chosen integrator cannot integrate the chosen contact law.
+    ///
+    /// What to do: use the integrator the message's hint names.
     #[error("integrator '{integrator}' cannot integrate the '{law}' contact law: {hint}")]
     Unsupported {
         /// The integrator's name.
@@ -282,6 +342,8 @@ pub enum SimError {
     },
     /// An analysis that needs the cantilever's Galerkin structure was given another
     /// [`crate::tip_sample::TipSampleSystem`].
+    ///
+    /// What to do: run the analysis on the cantilever model.
     #[error("{analysis} needs the cantilever model (its Galerkin matrices and mode shapes); this system is not one")]
     NotCantilever {
         /// The analysis.
@@ -289,6 +351,8 @@ pub enum SimError {
     },
     /// Every independent run of an analysis failed (every random start of an attractor census,
     /// every point of a sweep): there is no answer to report.
+    ///
+    /// What to do: read the first run's error, which is the cause; correct its input.
     #[error("every one of the {runs} {what} failed; the first: {first}")]
     EveryRunFailed {
         /// What the runs are ("random starts", "sweep points").
@@ -300,6 +364,9 @@ pub enum SimError {
     },
     /// A result's document holds no finite value in any of its results (`report`'s audit of
     /// the door): there is no answer to report.
+    ///
+    /// What to do: check the request's ranges and the model: every result is NaN; run one
+    /// point (`simulate`, `orbit`) to see why.
     #[error(
         "{what}: no finite value in any of its results ({arrays}): there is no answer to report"
     )]
@@ -310,9 +377,13 @@ pub enum SimError {
         arrays: String,
     },
     /// The caller cancelled the run ([`crate::analysis::progress::Progress::cancel`]).
+    ///
+    /// What to do: nothing: the run was stopped by its caller (Ctrl-C, or `progress.cancel()`).
     #[error("cancelled")]
     Cancelled,
     /// The adaptive oracle integrator reported a failure.
+    ///
+    /// What to do: use another integrator (the default), or a larger tolerance.
     #[error("adaptive integrator failed at tau = {tau}: {message}")]
     Adaptive {
         /// Time of the failure.
@@ -321,9 +392,14 @@ pub enum SimError {
         message: String,
     },
     /// A file of the run could not be written (the message names it).
+    ///
+    /// What to do: check that the path the message names can be written (its directory,
+    /// permissions, free space).
     #[error("{0}")]
     File(String),
     /// A run would exceed a documented memory or work budget; refused before allocating.
+    ///
+    /// What to do: do what the message's hint says: a coarser grid, fewer points or a shorter run.
     #[error("{what}: {needed} exceeds the budget of {budget} ({hint})")]
     Budget {
         /// What would be too large.

@@ -77,6 +77,19 @@
 //! `cargo build -p afmdyn --lib --target wasm32-unknown-unknown --no-default-features`).
 #![warn(missing_docs)]
 
+/// A warning of a result's document: `warning!("code", "what to do", "message {x}", args…)` is
+/// `format!("message {x}", args…)`. The code and the advice are for the book's catalogue of
+/// messages (`docs/reference/messages.md`), which `scripts/gen_reference.py` writes from these
+/// invocations; it fails on a warning pushed without one.
+macro_rules! warning {
+    ($code:literal, $todo:literal, $($message:tt)+) => {{
+        let _: [&str; 2] = [$code, $todo];
+        #[allow(clippy::useless_format)]
+        let message = format!($($message)+);
+        message
+    }};
+}
+
 pub mod analysis;
 pub(crate) mod beam;
 pub mod cantilevers;

@@ -313,6 +313,23 @@ fn probe_keys() -> Value {
             }
         }
     }
+    // each key's default (probe::defaults), one per key the reader knows
+    use afmdyn::probe::defaults::KEY_DEFAULTS;
+    for e in &mut out {
+        let key = e["key"].as_str().unwrap().to_string();
+        let d = KEY_DEFAULTS.iter().find(|d| d.0 == key);
+        e["default"] = json!(
+            d.unwrap_or_else(|| panic!("{key}: no KEY_DEFAULTS entry"))
+                .2
+        );
+    }
+    for d in KEY_DEFAULTS {
+        assert!(
+            out.iter().any(|e| e["key"] == d.0),
+            "{}: not a probe key",
+            d.0
+        );
+    }
     let laws: serde_json::Map<String, Value> = afmdyn::contact::LAWS
         .iter()
         .map(|l| (l.name.to_string(), json!(l.sample_keys)))
@@ -321,24 +338,94 @@ fn probe_keys() -> Value {
         "description": "Every key of a probe file, written by crates/afmdyn/tests/schema.rs from \
             the probe reader (its keys and the unit and sign it checks), its range table \
             (probe::ranges::SI_RANGES: refused outside [below, above], warned outside the \
-            typical range) and the law registry (contact::LAWS: the laws whose [sample] takes a \
-            key, the groups it sets).",
+            typical range), the law registry (contact::LAWS: the laws whose [sample] takes a \
+            key, the groups it sets) and its defaults (probe::defaults::KEY_DEFAULTS: the value \
+            a file without the key reads as).",
         "keys": out,
         "laws": laws,
     })
 }
 
+/// Every numeric default of `probe::defaults::KEY_DEFAULTS` is the reader's: a file of
+/// `examples/` that takes the key reads the same without it and with it set to the default.
+#[test]
+fn the_declared_defaults_are_the_readers() {
+    use afmdyn::probe::{defaults::KEY_DEFAULTS, Probe};
+    let examples = dir().join("../../../examples");
+    let read = |file: &str| -> toml::Table {
+        let text = std::fs::read_to_string(examples.join(file)).unwrap();
+        toml::from_str(&text).unwrap()
+    };
+    // an electrostatic sample: the DMT one with a bias
+    let mut electrostatic = read("probe-point-mass-dmt.toml");
+    let s = electrostatic["sample"].as_table_mut().unwrap();
+    s.insert("law".into(), "electrostatic".into());
+    s.insert("bias_voltage".into(), 1.0.into());
+    let mut checked = 0;
+    for (key, value, _) in KEY_DEFAULTS {
+        let Some(value) = value else { continue };
+        let (section, name) = key.split_once('.').unwrap();
+        let base = match *key {
+            "cantilever.tip_mass_ratio" => read("probe-beam-dmt.toml"),
+            "cantilever.tip_mass" | "sample.damping" => read("probe-geometry-hertz.toml"),
+            "sample.surface_tension" | "sample.contact_angle" => read("probe-capillary-humid.toml"),
+            "sample.contact_potential" => electrostatic.clone(),
+            _ => read("probe-point-mass-dmt.toml"),
+        };
+        let probe = |v: Option<f64>| {
+            let mut t = base.clone();
+            let s = t[section].as_table_mut().unwrap();
+            s.remove(name);
+            if let Some(v) = v {
+                s.insert(name.into(), v.into());
+            }
+            Probe::parse(&toml::to_string(&t).unwrap(), key).unwrap()
+        };
+        assert_eq!(
+            probe(None),
+            probe(Some(*value)),
+            "{key}: its default is not {value}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 9);
+}
+
 #[test]
 fn probe_keys_match_the_committed_file() {
-    let path = dir().join("../probe-keys.json");
-    let text = serde_json::to_string_pretty(&probe_keys()).unwrap() + "\n";
+    committed("probe-keys.json", &probe_keys());
+}
+
+/// The columns the library declares for a CSV file that has no `.npy.json` beside it
+/// (`docs/schema/csv-columns.json`, which `scripts/gen_reference.py` shows in the book's CSV
+/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]) and `converge.csv`'s
+/// (`{N}` in a name stands for a number).
+#[test]
+fn csv_columns_match_the_committed_file() {
+    let columns = |c: &[(&str, &str, &str)]| -> Vec<Value> {
+        c.iter()
+            .map(|(name, unit, meaning)| serde_json::json!({"name": name, "unit": unit, "meaning": meaning}))
+            .collect()
+    };
+    let chart = columns(&afmdyn::request::chart::CSV_COLUMNS);
+    let converge = columns(&afmdyn::report::present::converge::COLUMNS);
+    committed(
+        "csv-columns.json",
+        &serde_json::json!({"chart.csv": chart, "converge.csv": converge}),
+    );
+}
+
+/// `value` is the committed `docs/schema/<name>` (`AFMDYN_WRITE_SCHEMA=1` writes it).
+fn committed(name: &str, value: &Value) {
+    let path = dir().join("..").join(name);
+    let text = serde_json::to_string_pretty(value).unwrap() + "\n";
     if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
         std::fs::write(&path, &text).unwrap();
     }
     assert_eq!(
         std::fs::read_to_string(&path).ok().as_deref(),
         Some(text.as_str()),
-        "docs/schema/probe-keys.json differs from the library; regenerate with \
+        "docs/schema/{name} differs from the library; regenerate with \
          AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::schema::"
     );
 }

@@ -245,7 +245,11 @@ impl AttractorReport {
             .map(|a| a.count)
             .sum();
         if undecided > 0 {
-            w.push(format!(
+            w.push(warning!(
+                "attractors.undecided",
+                "Raise max_periods (a lever of quality factor Q settles over ~Q periods): \
+                 λ₁ then tells a quasi-periodic motion (≈ 0) from one still settling (< \
+                 0).",
                 "{undecided} start(s) ended on a nonperiodic motion with λ₁ ≈ 0 (within twice \
                  its error) after the transient cap of {} drive periods: quasi-periodic, or \
                  still settling; raise max_periods to tell (a lever of quality factor Q \
@@ -262,7 +266,9 @@ impl AttractorReport {
             .iter()
             .filter_map(|a| a.lyapunov.map(|l| l.0))
             .fold(f64::NEG_INFINITY, f64::max);
-        w.push(format!(
+        w.push(warning!(
+            "attractors.unsettled",
+            "Raise max_periods until every start settles on an attractor.",
             "{ends} start(s) had not settled after the transient cap of {} drive periods \
              (nonperiodic with λ₁ ≤ {worst:.3e} < 0: still converging; not counted as \
              attractors): raise max_periods",

@@ -261,13 +261,18 @@ fn run_warnings(
 ) -> Vec<String> {
     let mut w = vec![];
     if periods < MIN_PERIODS {
-        w.push(format!(
+        w.push(warning!(
+            "lyapunov.short",
+            "Run at least the recommended number of periods (the default is 4000).",
             "only {periods} periods averaged (at least {MIN_PERIODS} recommended, default \
              4000): the exponents have not converged and their signs are not reliable"
         ));
     }
     if periods / blocks.max(1) < 20 {
-        w.push(format!(
+        w.push(warning!(
+            "lyapunov.blocks",
+            "Run more periods, or fewer blocks, so that each block holds at least 20 \
+             periods.",
             "{} periods per block: the uncertainties are estimated from blocks too short to be \
              independent",
             periods / blocks.max(1)
@@ -281,7 +286,10 @@ fn run_warnings(
         .map(|(k, _)| (k + 1).to_string())
         .collect();
     if !unresolved.is_empty() {
-        w.push(format!(
+        w.push(warning!(
+            "lyapunov.unresolved",
+            "Run more periods, until the exponents' uncertainty is small against their \
+             size.",
             "exponent(s) {} not resolved from zero (|λ| ≤ 2 × (uncertainty + convergence)): run \
              more periods",
             unresolved.join(", ")

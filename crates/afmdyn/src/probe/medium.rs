@@ -195,7 +195,10 @@ pub(super) struct Vacuum {
 fn intrinsic(q: f64, mode: &crate::hydro::WetMode, key: &str, warnings: &mut Vec<String>) -> f64 {
     let inv = 1.0 / q - 1.0 / mode.quality_factor;
     if inv <= 0.0 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "probe.q-above-air",
+            "If the quality factor was measured in vacuum, say so: [medium] calibrated_in \
+             = 'vacuum'.",
             "[cantilever].{key} = {}: at or above {}, the quality factor air damping alone \
              allows this lever's plan at {} Hz (Sader 1998, for a long lever, L ≫ b): the \
              lever's own loss is taken as nil and its fluid loading from the plan (a short or \

@@ -119,6 +119,7 @@
 //! a modulus of 4 Pa, a resonance at 300 Hz: read as a unit slip, with the reading meant), all
 //! listed in one [`ProbeError::Invalid`].
 
+pub mod defaults;
 mod medium;
 pub mod ranges;
 mod reader;
@@ -428,7 +429,10 @@ impl Probe {
     /// paraboloid (Hertz-family) contact.
     pub(crate) fn indentation_warnings(&self, indentation: f64) -> Vec<String> {
         match self.tip_radius {
-            Some(r) if indentation > INDENTATION_VALIDITY * r => vec![format!(
+            Some(r) if indentation > INDENTATION_VALIDITY * r => vec![warning!(
+                "probe.deep-indentation",
+                "Keep the tip shallower: a smaller amplitude, a larger setpoint A/A₀ or a \
+                 smaller peak-force setpoint (or a stiffer sample).",
                 "the largest indentation, {} m, exceeds half the tip radius R = {} m: the \
                  {} law's paraboloid contact holds for indentations well below R (contact \
                  radius √(Rδ) ≪ R; Johnson 1985, §4.2), so forces and indentations there are \
@@ -451,14 +455,18 @@ impl Probe {
         let mut w = self.input_warnings.clone();
         let jkr = matches!(self.params.contact_law, ContactLaw::Jkr { .. });
         if let Some(mu) = self.tabor_parameter.filter(|&mu| jkr && mu < TABOR_DMT) {
-            w.push(format!(
+            w.push(warning!(
+                "probe.tabor-dmt",
+                "Give law = 'dmt' in [sample].",
                 "the sample's Tabor parameter is {mu:.3} (< {TABOR_DMT}: a stiff, weakly \
                  adhesive contact, DMT's regime; Johnson & Greenwood 1997): JKR's neck is then an \
                  overestimate, law = \"dmt\" applies"
             ));
         }
         if let Some(mu) = self.tabor_parameter.filter(|&mu| !jkr && mu > TABOR_JKR) {
-            w.push(format!(
+            w.push(warning!(
+                "probe.tabor-jkr",
+                "Give law = 'jkr' in [sample].",
                 "the sample's Tabor parameter is {mu:.3} (> {TABOR_JKR}: a compliant, adhesive \
                  contact, JKR's regime; Johnson & Greenwood 1997): DMT misses the contact's neck \
                  and the adhesion hysteresis of each tap, so adhesion and dissipation are \

@@ -273,13 +273,20 @@ impl SiRange {
             .iter()
             .find(|(_, f)| (lo..=hi).contains(&(x * f)));
         Some(match meant {
-            Some((prefix, f)) => format!(
+            Some((prefix, f)) => warning!(
+                "probe.unit-slip",
+                "Write the value in SI units (the probe reader takes SI), or keep it if \
+                 it is meant.",
                 "outside the typical {range}: was it meant in {prefix}{unit}? ({} {prefix}{unit} \
                  is {} {unit})",
                 crate::error::number(x),
                 crate::error::number(x * f)
             ),
-            None => format!("outside the typical {range}: {reminder}"),
+            None => warning!(
+                "probe.atypical",
+                "Check the value and its unit (SI); keep it if it is meant.",
+                "outside the typical {range}: {reminder}"
+            ),
         })
     }
 }

@@ -125,7 +125,9 @@ impl Probe {
         let shape = Self::read_shape(r, t);
         if !shape.has_radius() {
             if radius.is_some() {
-                r.warnings.push(format!(
+                r.warnings.push(warning!(
+                    "probe.radius-unused",
+                    "Remove [tip].radius, or give a shape with a radius.",
                     "[tip].radius is not used by the {} shape (the sharp indenter's force \
                      has no radius)",
                     shape.name()

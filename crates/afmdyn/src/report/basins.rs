@@ -91,7 +91,10 @@ pub(crate) fn warnings(spec: &BasinSpec, map: &BasinMap) -> Vec<String> {
         .filter_map(|(i, (s, l))| match (s.period(), l) {
             (None, Some(l)) if *l <= 0.0 => {
                 let cells = map.cells.iter().filter(|c| c.label == i as i64).count();
-                Some(format!(
+                Some(warning!(
+                    "basins.nonperiodic",
+                    "Raise max_periods: λ₁ then tells a quasi-periodic attractor (≈ 0) \
+                     from one still settling (< 0).",
                     "attractor {i} ({cells} cells) is nonperiodic with λ₁ = {l:.3e} ≤ 0 after \
                      the transient cap of {} drive periods: quasi-periodic, or still settling; \
                      raise max_periods to tell",

@@ -1,5 +1,5 @@
 //! The one layout of a chart's results (issue 29): [`ChartArrays`], the variables of
-//! `chart.nc` and of Python's `xarray.Dataset`, and [`CSV_HEADER`] / [`csv_lines`], the rows of
+//! `chart.nc` and of Python's `xarray.Dataset`, and [`CSV_COLUMNS`] / [`csv_lines`], the rows of
 //! `chart.csv` (the request is `crate::request::chart`'s).
 
 use crate::analysis::chart::{ChartCell, ChartSpec};
@@ -16,28 +16,41 @@ pub(crate) struct ChartAxis<'a> {
     pub(crate) unit: &'a str,
 }
 
-/// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
-/// empty, for a cell without any).
-pub const CSV_HEADER: [&str; 18] = [
-    "ix",
-    "iy",
-    "x",
-    "y",
-    "attractor",
-    "status",
-    "period",
-    "lyapunov",
-    "lyapunov_error",
-    "x_max",
-    "v_t_min",
-    "contacts_per_period",
-    "contact_fraction",
-    "count",
-    "fraction",
-    "origin",
-    "failures",
-    "message",
+/// The columns of `chart.csv` with their unit and meaning (the book's reference of the CSV
+/// files shows them): one row per attractor of a cell (one row, with `attractor` empty, for a
+/// cell without any).
+#[rustfmt::skip]
+pub const CSV_COLUMNS: [(&str, &str, &str); 18] = [
+    ("ix", "–", "column of the cell"),
+    ("iy", "–", "row of the cell"),
+    ("x", "the x axis' unit", "the cell's value of the x parameter"),
+    ("y", "the y axis' unit", "the cell's value of the y parameter"),
+    ("attractor", "–", "index of the attractor in the cell (empty for a cell with none)"),
+    ("status", "–", "periodic; a nonperiodic one by λ₁ against twice its error: chaotic (above), quasiperiodic (within: quasi-periodic, or settling too slowly to tell), unsettled (below: still converging after max_periods); nonperiodic without λ₁; none"),
+    ("period", "drive periods", "n of a period-n attractor (empty otherwise)"),
+    ("lyapunov", "1/τ", "λ₁ of a nonperiodic attractor (empty otherwise)"),
+    ("lyapunov_error", "1/τ", "its error: the uncertainty over 10 blocks plus the convergence estimate (empty otherwise)"),
+    ("x_max", "g0; m with a probe", "largest W(1,τ) over the recorded steady state (with a probe each row in its cell's length unit A₀, which follows a free_amplitude axis)"),
+    ("v_t_min", "g0; m with a probe", "smallest V_T over the recorded steady state"),
+    ("contacts_per_period", "1/period", "contact entries and impacts per drive period"),
+    ("contact_fraction", "1", "fraction of the time in contact"),
+    ("count", "–", "random starts that reached it"),
+    ("fraction", "1", "that count over the number of starts (0 for one found only by continuation)"),
+    ("origin", "–", "start, left or right: how it was first found"),
+    ("failures", "–", "runs of the cell that failed"),
+    ("message", "–", "the first failed run's message"),
 ];
+
+/// The names of [`CSV_COLUMNS`], the header of `chart.csv`.
+pub const CSV_HEADER: [&str; 18] = {
+    let mut names = [""; 18];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = CSV_COLUMNS[i].0;
+        i += 1;
+    }
+    names
+};
 
 /// The rows of a cell as CSV lines of [`CSV_HEADER`] (numbers in Rust's shortest round-trip
 /// form; messages with commas and newlines replaced by spaces). The lengths `x_max` and

@@ -72,7 +72,10 @@ impl Convergence {
             "all": self.converged(),
         });
         if !self.converged() {
-            let warning = Value::from(format!(
+            let warning = Value::from(warning!(
+                "converged.partial",
+                "Read the other warnings for which parts and why; a larger transient cap \
+                 (max_periods) or budget usually settles them.",
                 "convergence: {} of {} {} did not converge (the document's converged)",
                 self.of - self.settled,
                 self.of,

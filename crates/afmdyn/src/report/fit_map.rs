@@ -133,7 +133,10 @@ fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> 
         let name = CurveFlag::NAMES[flag.code() as usize];
         let n = counts.get(name).and_then(Value::as_u64).unwrap_or(0);
         if let Some(first) = m.curves.iter().find(|c| c.flag == flag) {
-            w.push(format!(
+            w.push(warning!(
+                "fit-map.flagged",
+                "Look at the flagged curves (the map's flag) and refit them alone, with \
+                 other bounds, start values or range.",
                 "{n} of {total} curves {}: the first at x = {:.4e} m, y = {:.4e} m: {}",
                 name.replace('_', " "),
                 first.x,
@@ -148,7 +151,10 @@ fn warnings(m: &FitMap, counts: &serde_json::Map<String, Value>) -> Vec<String> 
         .filter(|c| c.data_warning.is_some())
         .collect();
     if let Some(first) = slips.first() {
-        w.push(format!(
+        w.push(warning!(
+            "fit-map.data",
+            "Check the map's units and the probe's spring constant: the first curve's \
+             message names the column.",
             "{} of {total} curves' data look off against the probe: the first at x = {:.4e} m, \
              y = {:.4e} m: {}",
             slips.len(),

@@ -65,18 +65,23 @@ pub(crate) fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
     let mut w = vec![];
     let relative = s.energy_residual.map_or(0.0, |r| r.1);
     if relative.is_nan() || relative > ENERGY_TOLERANCE {
-        w.push(format!(
+        w.push(warning!(
+            "simulate.energy",
+            "Integrate more finely (more steps per period, or an adaptive integrator with \
+             a smaller tolerance), or keep the parameters inside the valid range.",
             "energy balance violated: a per-period residual of {relative:.1e} relative \
              (tolerance 1e-6); the trajectory is not accurate (integrator too coarse, or \
              parameters at the edge of the valid range)"
         ));
     }
     if s.body_contact {
-        w.push(
+        w.push(warning!(
+            "simulate.body-contact",
+            "Raise the gap (z_c) or lower the amplitude: the model assumes that only the \
+             tip touches.",
             "a point of the beam other than the tip reached the substrate (paper Fig. 2f): \
              outside the model's assumption"
-                .into(),
-        );
+        ));
     }
     w
 }

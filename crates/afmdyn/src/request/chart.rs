@@ -23,7 +23,7 @@ use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-pub use crate::report::chart_layout::{ChartArrays, CSV_HEADER};
+pub use crate::report::chart_layout::{ChartArrays, CSV_COLUMNS, CSV_HEADER};
 
 /// Largest number of cells of a chart (x_steps × y_steps).
 pub(crate) const MAX_CHART_CELLS: usize = 1_000_000;

@@ -117,7 +117,9 @@ pub(crate) fn unit_slip(
             let read = magnitude * 10f64.powi(*p);
             format!(": written in {name}? (in {name} it would be {read:.3e} {unit}; data are read in SI)")
         });
-    Some(format!(
+    Some(warning!(
+        "data.unit-slip",
+        "Check the column's unit: data are read in SI (m, N, s, Hz).",
         "{column}: {what} is {magnitude:.3e} {unit}, outside the {lo:.0e}..{hi:.0e} {unit} this \
          probe's data take{likely}"
     ))

@@ -229,7 +229,11 @@ impl ReconstructRequest {
                 .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
                 .map_or((0, 0.0), |(i, v)| (i, *v));
             if far.abs() > DECAYED * extreme.abs() {
-                warnings.push(format!(
+                warnings.push(warning!(
+                    "reconstruct.undecayed",
+                    "Take data out to where the shift has decayed; until then, read the \
+                     force within about an amplitude of the data's end as not \
+                     reconstructed.",
                     "the frequency shift at the largest distance (d = {} m) is still {} % of its \
                      extreme ({} Hz at d = {} m): the force there and within about an amplitude \
                      of it is not reconstructed (the inversion integrates the shift beyond each \

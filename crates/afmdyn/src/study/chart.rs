@@ -179,7 +179,10 @@ pub(crate) fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
     };
     let unsettled: Vec<&ChartCell> = cells.iter().filter(settling).collect();
     if let Some(first) = unsettled.first() {
-        w.push(format!(
+        w.push(warning!(
+            "chart.nonperiodic",
+            "Raise max_periods (a lever settles over ~Q periods): λ₁ then tells \
+             quasi-periodic from still settling.",
             "{} of {} cells have a nonperiodic motion with λ₁ ≤ 0 (first at x = {}, y = {}): \
              quasi-periodic, or still settling after the transient cap ({}); raise \
              max_periods to tell (a cantilever of quality factor Q settles over ~Q periods)",
@@ -199,7 +202,10 @@ pub(crate) fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
             .iter()
             .find_map(|c| c.message.as_deref())
             .unwrap_or("");
-        w.push(format!(
+        w.push(warning!(
+            "chart.failed-runs",
+            "Read the first failure's message; the failed runs are missing from their \
+             cells' census.",
             "{failed} runs failed in {} of {} cells; the first: {first}",
             cells.iter().filter(|c| c.failures > 0).count(),
             cells.len()

@@ -200,7 +200,9 @@ fn sls_start_warning(model: &SlsCurveModel, p: &[f64]) -> Option<String> {
     let mut f = vec![0.0; model.height.len()];
     model.forces(p, &mut f, None);
     f.first().is_some_and(|f| *f > 0.0).then(|| {
-        format!(
+        warning!(
+            "fit.sls-start",
+            "Record the approach from off the surface.",
             "the fitted curve is in contact at its first row ({:.3e} N): the sls model \
              starts the sample at rest there, so a curve that starts on the surface is \
              misfitted; record the approach from off the surface",
@@ -236,7 +238,9 @@ fn contact_point_warning(tip: &[f64], contact: f64) -> Option<String> {
     let (lo, hi) = crate::request::quantity::extent(tip);
     let h = (hi - lo).max(0.0);
     (contact < lo - h || contact > hi + h).then(|| {
-        format!(
+        warning!(
+            "fit.contact-point",
+            "Check the columns' units and the curve's segment.",
             "contact_point = {contact:.4e} m lies far outside the tip positions measured \
              ({lo:.4e} to {hi:.4e} m, after the preprocessing's offset): the fit has not found the contact; check the columns' units and the \
              curve's segment"

@@ -104,11 +104,13 @@ pub(crate) fn execute(
         .warnings
         .extend(data.unit_slips(probe.free_amplitude, probe.calibration.resonance_frequency));
     if fm && (data.amplitude.is_some() || data.phase.is_some()) {
-        outcome.warnings.push(
+        outcome.warnings.push(warning!(
+            "fit.fm-columns",
+            "Nothing, for an FM curve; without the frequency_shift column the \
+                 amplitude and phase are fitted as an AM curve.",
             "the data have a frequency_shift column: fitted as an FM curve (the loop holds the \
              probe's free amplitude); their amplitude and phase columns are not fitted"
-                .into(),
-        );
+        ));
     }
     let names: Vec<&'static str> = params
         .iter()

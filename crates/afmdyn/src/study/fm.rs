@@ -160,7 +160,9 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
     }
     if let (Some(from), Some(to)) = (request.from, request.to) {
         if from < to {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "fm.reversed",
+                "Give from > to: an FM curve is taken approaching.",
                 "from = {} {unit} is nearer the sample than to = {} {unit}: an FM curve is \
                  taken approaching, so it runs from z_c = {} {unit} down to {} {unit} (give \
                  from > to to say so)",
@@ -172,7 +174,10 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
         }
     }
     if let Some(u) = &curve.unreached {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fm.unreached",
+            "Read the reason given; end the range before that z_c (to), or change the \
+             amplitude.",
             "the FM steady state was not found at z_c = {}{} and beyond ({}); the curve ends at \
              the previous value",
             crate::error::number(frame.z_c(u.alpha5)),

@@ -225,10 +225,14 @@ pub(crate) fn image_of(
     warnings.extend(curve_warnings(curves));
     for m in &materials {
         if m.points.is_empty() {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "image.setpoint-unreached",
+                "Give a setpoint that every material's approach curve reaches, or a \
+                 longer range of its curves.",
                 "{}: the setpoint A/A0 = {} is not reached on its approach curve: its pixels \
                  are empty (NaN)",
-                m.name, req.setpoint
+                m.name,
+                req.setpoint
             ));
         }
     }
@@ -267,7 +271,10 @@ pub(crate) fn image_of(
         pixels.push(line);
     }
     if switches > 0 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "image.regime-switch",
+            "For one regime over the whole image, give a setpoint at which every material \
+             has an operating point in it.",
             "{switches} pixel(s) switch regime (attractive ↔ repulsive) where a material has no \
              operating point in the previous one's: the image's contrast changes there"
         ));

@@ -295,7 +295,9 @@ fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> 
         return Vec::new();
     }
     let Some(fit) = tap.fit else {
-        return vec![format!(
+        return vec![warning!(
+            "peakforce.no-fit",
+            "Raise samples, or widen fit_band.",
             "modulus_dmt is missing: the DMT fit needs at least {} retract points between {} and \
              {} of the force range from the adhesion to the peak force, and this tap's retract \
              has fewer there (a contact short against the cycle's samples: raise samples, or \
@@ -307,7 +309,10 @@ fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> 
     };
     let mut w = Vec::new();
     if fit.relative_residual > MAX_FIT_RESIDUAL {
-        w.push(format!(
+        w.push(warning!(
+            "peakforce.fit-residual",
+            "Read modulus_dmt of this tap as not meaningful; check the contact law and \
+             fit_band.",
             "modulus_dmt: the DMT fit's relative residual is {:.3} (above {MAX_FIT_RESIDUAL}): \
              the retract curve in the fit band does not have the DMT relation's shape, so the \
              modulus is not meaningful",
@@ -321,7 +326,10 @@ fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> 
             "hertz" | "dmt" => String::new(),
             _ => format!("a {law} sample read with the DMT relation, "),
         };
-        w.push(format!(
+        w.push(warning!(
+            "peakforce.modulus-bias",
+            "Calibrate the reading against a sample of known modulus; do not read it as \
+             the sample's modulus.",
             "modulus_dmt reads {ratio:.3} × the sample's own E* (more than {:.0} % off): the DMT \
              fit of this tap is biased ({other_law}{BIAS_CAUSE}): compare it against a \
              calibration sample, not as the sample's modulus",
@@ -485,7 +493,9 @@ fn sweep_block(
             .as_array()
             .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
         if failed > 0 {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "peakforce.failed-values",
+                "Read sweep.message for each failed value.",
                 "{failed} of the sweep's values failed (null in sweep.channels; their \
                  messages in sweep.message)"
             ));

@@ -484,7 +484,10 @@ impl PeakForceImageStudy {
                 } else {
                     format!("{hi:.3}")
                 };
-                Some(format!(
+                Some(warning!(
+                    "peakforce-image.modulus-bias",
+                    "Calibrate the reading against a material of known modulus; do not \
+                     read it as the material's modulus.",
                     "{}: modulus_dmt reads {reads} × the material's own E* on {} of its {} \
                      single-tap pixels (more than {:.0} % off): the DMT fit is biased there \
                      ({cause}): compare it against a calibration sample, not as the material's \
@@ -541,7 +544,10 @@ impl PeakForceImageStudy {
         let all = || pixels.iter().flatten();
         let reengaged = all().filter(|p| p.reengaged).count();
         if reengaged > 0 {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "peakforce-image.reengaged",
+                "Look at those pixels: the steady taps fold there, or a tap does not \
+                 settle; another setpoint may avoid it.",
                 "{reengaged} pixel(s) re-engaged from far: the feedback's continuation from the \
                  previous pixel did not converge there (a fold of the steady taps, or a tap that \
                  does not settle)"
@@ -549,18 +555,29 @@ impl PeakForceImageStudy {
         }
         let taps = || all().filter_map(|p| p.tap);
         if taps().any(|t| t.taps_per_cycle > 1.0 + 1e-9) {
-            warnings.push(
+            warnings.push(warning!(
+                "peakforce-image.double-tap",
+                "Find them by taps_per_cycle; their modulus_dmt is not meaningful.",
                 "double taps on some pixels (more than one contact per modulation period): \
                  modulus_dmt is not meaningful there (taps_per_cycle)"
-                    .into(),
-            );
+            ));
         }
         if taps().any(|t| t.period > 1) {
-            warnings.push("period-2 (or longer) tapping on some pixels (period)".into());
+            warnings.push(warning!(
+                "peakforce-image.period",
+                "Find them by period; their cycle shows the first of its modulation \
+                 periods.",
+                "period-2 (or longer) tapping on some pixels (period)"
+            ));
         }
         warnings.extend(self.modulus_bias(&materials, &pixels, &x, &y));
         if taps().any(|t| !t.stable) {
-            warnings.push("unstable steady taps on some pixels (stable = false)".into());
+            warnings.push(warning!(
+                "peakforce-image.unstable",
+                "Find them by stable; their values are those of an orbit the lever does \
+                 not stay on.",
+                "unstable steady taps on some pixels (stable = false)"
+            ));
         }
         Ok(PeakForceImage {
             setpoint: self.request.setpoint,

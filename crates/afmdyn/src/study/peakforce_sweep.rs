@@ -50,17 +50,22 @@ pub(crate) fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
     if tap.period > 1 {
         warnings.push((
             "period",
-            format!(
+            warning!(
+                "peakforce.period",
+                "Nothing: the cycle shows the first of its modulation periods.",
                 "period-{} tapping: the orbit repeats after {} modulation periods; the cycle \
                  shows the first",
-                tap.period, tap.period
+                tap.period,
+                tap.period
             ),
         ));
     }
     if c.taps_per_cycle > 1.0 + 1e-9 {
         warnings.push((
             "double-tap",
-            format!(
+            warning!(
+                "peakforce.double-tap",
+                "Read modulus_dmt of this cycle as not meaningful.",
                 "{} contacts per modulation period: double taps (the lever's ringing reaches the \
                  sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is \
                  not meaningful for such a cycle",
@@ -71,7 +76,12 @@ pub(crate) fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
     if !tap.stable {
         warnings.push((
             "unstable",
-            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
+            warning!(
+                "peakforce.unstable",
+                "Read the values as those of an orbit the lever does not stay on; \
+                 simulate the cycle to see its motion.",
+                "the steady tap is unstable (a Floquet multiplier outside the unit circle)"
+            ),
         ));
     }
     if c.peak_force <= 0.0 {
@@ -83,7 +93,14 @@ pub(crate) fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
         } else {
             "the sample never reaches the tip at this z_c"
         };
-        warnings.push(("no-contact", format!("no repulsive contact: {why}")));
+        warnings.push((
+            "no-contact",
+            warning!(
+                "peakforce.no-contact",
+                "Lower z_c until the tip presses on the sample.",
+                "no repulsive contact: {why}"
+            ),
+        ));
     }
     warnings
 }
@@ -124,7 +141,9 @@ pub(crate) fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
             if at.len() > 3 {
                 list.push(show(at.last().expect("non-empty")));
             }
-            format!(
+            warning!(
+                "peakforce.sweep",
+                "Read sweep.warnings for each value's own warning.",
                 "at {} of the sweep's {} values ({quantity} = {} {unit}): {message} (each \
                  value's in sweep.warnings)",
                 at.len(),

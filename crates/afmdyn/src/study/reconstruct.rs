@@ -143,7 +143,10 @@ fn inversion_convergence(r: &Reconstruction) -> Convergence {
 /// the forward residual, typically in the rows within 2A of the data's end), or `None`.
 fn exact_warning(e: &crate::analysis::reconstruct::ExactRecord) -> Option<String> {
     (!e.converged).then(|| {
-        format!(
+        warning!(
+            "reconstruct.exact-unconverged",
+            "Read the force within 2A of the data's end as the last iterate; take data \
+             further out.",
             "the exact inversion did not converge (exact.converged = false): it stopped after \
              {} correction step(s) at a forward residual of {} of the largest |Δf| (Sader–Jarvis's: \
              {}), above round-off ({}), where a step no longer shrank it — usually in the rows \

@@ -309,14 +309,18 @@ impl ScanStudy {
         img.artefacts = [0, 1].map(|d| img.artefacts_of(d));
         for (d, a) in ["trace", "retrace"].iter().zip(img.artefacts) {
             if a.lost_contact_pixels > 0 {
-                img.warnings.push(format!(
+                img.warnings.push(warning!(
+                    "scan.lost-contact",
+                    "Scan slower or raise the gains.",
                     "{d}: {} pixel(s) lost contact (the tip left the sample and the amplitude \
                      rose toward the free amplitude: parachuting; scan slower or raise the gains)",
                     a.lost_contact_pixels
                 ));
             }
             if a.saturated_periods > 0 {
-                img.warnings.push(format!(
+                img.warnings.push(warning!(
+                    "scan.saturated",
+                    "Scan slower, or lower the gains.",
                     "{d}: the controller's output sat at a limit of its range (the approach \
                      curves' z_c range above the local surface) for {} drive period(s): a step \
                      too steep for the scan rate pressed the tip to the lowest z_c, or the loop \

@@ -272,7 +272,9 @@ fn soft_sample_warning(
         return None;
     }
     let z = crate::analysis::approach::rest_distance(params, last.value) * u.length;
-    Some(format!(
+    Some(warning!(
+        "approach.soft-sample",
+        "Take a softer lever or a smaller A0, or give a deeper `to` for the range.",
         "the amplitude stays above {} A0 down to the default range's end, z_c = {} {}, where \
          the sample already pushes back with the peak force of tapping at A/A0 = 0.5 (about \
          min(1, 3/Q) k A0): the sample is too compliant for this lever to reach the usual setpoints (A/A0 ≤ 0.5) \

@@ -80,11 +80,13 @@ impl super::named::Datasets for ThermalRequest {
 pub(crate) fn document(r: &ThermalRequest, s: &ThermalSpectrum) -> Value {
     let mut warnings = r.warnings();
     if !s.reads_slope {
-        warnings.push(
+        warnings.push(warning!(
+            "thermal.no-beam",
+            "Nothing, for a point mass or eigenmodes; a beam model gives the optical \
+                 lever's own correction factors.",
             "the model has no beam (point mass or eigenmodes): the optical lever's apparent \
              deflection is the deflection, its correction factors those of the deflection"
-                .into(),
-        );
+        ));
     }
     json!({
         "temperature": s.temperature,

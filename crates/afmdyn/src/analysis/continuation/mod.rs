@@ -159,18 +159,30 @@ impl BranchEnd {
             )
         };
         Some(match *self {
-            BranchEnd::Budget { value, steps } => format!(
+            BranchEnd::Budget { value, steps } => warning!(
+                "continuation.budget",
+                "Narrow --from/--to, or continue from the value where the branch ended \
+                 with --from.",
                 "{} after {steps} adaptive steps ({cause}); narrow --from/--to, or continue from \
                  there with --from",
                 at(value)
             ),
             BranchEnd::MaxPoints { value } => {
-                format!(
+                warning!(
+                    "continuation.max-points",
+                    "Continue from the value where the branch ended with --from.",
                     "{} after {cause}; continue from there with --from",
                     at(value)
                 )
             }
-            BranchEnd::StepFloor { value } => format!("{}: {cause}", at(value)),
+            BranchEnd::StepFloor { value } => warning!(
+                "continuation.step-floor",
+                "Look at the orbit near that value (orbit, simulate): a fold or a \
+                 bifurcation ends the branch there; continue past it from a start beyond \
+                 it (--from).",
+                "{}: {cause}",
+                at(value)
+            ),
             BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => unreachable!("complete"),
         })
     }

@@ -602,7 +602,10 @@ impl<C: Channels> CheckedModel for SteppedCurveModel<C> {
             }
         }
         if off > 0 {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "fit.off-orbit",
+                "Leave those rows out of the fit (range), or start nearer the data so \
+                 that the model's orbit there is the measured one.",
                 "{off} row(s) not on a stable period-1 orbit: their model values are the stepped \
                  sweep's, without sensitivities"
             ));

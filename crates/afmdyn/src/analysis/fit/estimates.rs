@@ -178,11 +178,13 @@ pub(crate) fn fit_at(
     let mut warnings = goodness_warnings(&best, noise_estimated, dof, chi2_dof);
     let (cov, singular) = covariance(model, obs, &best.values, &free, s2, progress)?;
     if singular {
-        warnings.push(
+        warnings.push(warning!(
+            "fit.singular",
+            "Fix a parameter the data cannot tell from another (give its value \
+                 instead of fitting it), or fit data that vary them separately.",
             "JᵀWJ is singular: the data do not constrain every combination of the fitted \
              parameters"
-                .into(),
-        );
+        ));
     }
     let (se, correlation) = standard_errors(&cov);
     let mut evaluations = best.evaluations + 1;
@@ -232,10 +234,14 @@ pub(crate) fn fit_at(
         for b in a + 1..n {
             let r = correlation[a][b];
             if r.abs() > CORRELATION_WARNING {
-                warnings.push(format!(
+                warnings.push(warning!(
+                    "fit.correlated",
+                    "Fix one of the two, or add data that separate them (another range, \
+                     setpoint or channel).",
                     "{} and {} are correlated at {r:.4} (|r| > {CORRELATION_WARNING}): the data \
                      fix a combination of them, not each",
-                    params[free[a]].name, params[free[b]].name
+                    params[free[a]].name,
+                    params[free[b]].name
                 ));
             }
         }
@@ -272,14 +278,19 @@ fn goodness_warnings(
 ) -> Vec<String> {
     let mut warnings = Vec::new();
     if !best.converged {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.unconverged",
+            "Fit again from other start values, nearer the minimum.",
             "the minimiser did not report convergence ({}): the estimates may not be at the \
              minimum",
             best.termination
         ));
     }
     if noise_estimated {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.noise-estimated",
+            "Give a σ column with the data's measured noise for standard errors that do \
+             not assume the model fits.",
             "noise estimated from residuals: no σ column, so σ² = χ²/dof = {:.4e} (the \
              standard errors and intervals assume the model fits)",
             chi2_dof
@@ -288,7 +299,10 @@ fn goodness_warnings(
     // with σ given, χ² of a model that fits is χ²(dof): mean dof, standard deviation √(2 dof)
     let bound = 1.0 + CHI2_SIGMAS * (2.0 / dof.max(1) as f64).sqrt();
     if !noise_estimated && dof > 0 && chi2_dof > bound {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.chi2",
+            "Try other start values (a local minimum), another contact law or model, or \
+             check that σ is not too small.",
             "χ²/dof = {} with the σ given, above {} ({CHI2_SIGMAS} standard deviations of χ²/dof \
              for {dof} degrees of freedom): the model does not describe the data within σ — a \
              local minimum (another start), another law or model, or σ too small; the standard \
@@ -352,27 +366,40 @@ fn profile_warnings(
             ),
             _ => String::new(),
         };
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.profile-flat",
+            "Read that end of the interval as open: fix the parameter, or fit data that \
+             bound it.",
             "{name}: flat profile — χ² rises by less than {DELTA_CHI2_95:.2} over the \
              range walked on {side}{walked}; the data do not bound it there (the \
              interval's end there is the last point walked: open)",
         ));
     }
     if pr.unconverged > 0 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.profile-unconverged",
+            "Read that interval as possibly too narrow; fit again from start values \
+             nearer the minimum.",
             "{name}: {} of the profile's {} refits stopped at the minimiser's limit of \
              evaluations before converging (their Δχ² may be high, the interval narrow)",
-            pr.unconverged, pr.refits
+            pr.unconverged,
+            pr.refits
         ));
     }
     if let Some(side) = sides(|e| matches!(e, ProfileEnd::Failed(_))) {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.profile-failed",
+            "Read that end of the interval as Wald's; narrower bounds keep the model \
+             defined.",
             "{name}: a profile refit failed on {side} (the model could not be evaluated \
              there): the Wald end p̂ ± 1.96 SE stands in",
         ));
     }
     if pr.lowest < -1e-6 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.profile-lower",
+            "Fit again from the profile's better point as the start: the fit stopped \
+             short of the minimum.",
             "{name}: the profile met a χ² lower than the fit's (by {:.3} in Δχ²): the fit \
              stopped short of the minimum",
             -pr.lowest
@@ -386,7 +413,10 @@ fn estimate_warnings(p: &Parameter, value: f64, se: f64, warnings: &mut Vec<Stri
     let width = (p.upper - p.lower).abs().min(p.scale.max(value.abs()));
     for (bound, which) in [(p.lower, "lower"), (p.upper, "upper")] {
         if bound.is_finite() && (value - bound).abs() <= 1e-6 * width {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "fit.at-bound",
+                "Widen that parameter's bounds, or check the data and the model: the best \
+                 value may lie beyond them.",
                 "{}: the estimate {value:.6e} is at its {which} bound {bound:.6e}",
                 p.name
             ));
@@ -394,7 +424,10 @@ fn estimate_warnings(p: &Parameter, value: f64, se: f64, warnings: &mut Vec<Stri
     }
     // (an offset without a natural zero — contact point, baseline — is not held to it)
     if !se.is_finite() || (p.lower.is_finite() && se >= value.abs()) {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "fit.unconstrained",
+            "Fix the parameter at a known value, or fit data that depend on it more \
+             strongly.",
             "{}: not constrained by the data (standard error {:.3e} ≥ |estimate| {:.3e})",
             p.name,
             se,

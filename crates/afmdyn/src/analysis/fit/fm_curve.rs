@@ -95,7 +95,10 @@ impl FmCurveModel {
     fn curve_warnings(&self, curve: &FmCurve) -> Vec<String> {
         let mut warnings = Vec::new();
         for f in &curve.folds {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "fit.fm-fold",
+                "Leave the rows near the fold out of the fit (range), or take the \
+                 intervals from the profile likelihood (profiles).",
                 "{}: a fold of the FM curve (det ∂(A₁, φ₁)/∂(Ω, α2) changes sign before the \
                  next row); the sensitivities are unreliable there",
                 self.row(f.index)
@@ -103,7 +106,10 @@ impl FmCurveModel {
         }
         let reached = curve.points.len();
         if let Some(u) = &curve.unreached {
-            warnings.push(format!(
+            warnings.push(warning!(
+                "fit.fm-unreached",
+                "Fit the rows before that distance only (range), or check the probe's \
+                 free amplitude and the sample's law there.",
                 "{}: the FM steady state was not found ({}); the {} row(s) from there keep the \
                  last frequency shift reached, without sensitivities",
                 self.row(reached),
@@ -212,7 +218,10 @@ impl CheckedModel for FmCurveModel {
                 s.d_phase[k + 1],
             );
             let Some(inv) = g_x.try_inverse() else {
-                warnings.push(format!(
+                warnings.push(warning!(
+                    "fit.fm-singular",
+                    "Leave that row out of the fit (range), or take the intervals from \
+                     the profile likelihood (profiles).",
                     "{}: ∂(A₁, φ₁)/∂(Ω, α2) is singular (a fold of the FM curve): no \
                      sensitivities",
                     row(i)

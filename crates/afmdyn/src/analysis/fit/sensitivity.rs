@@ -158,19 +158,23 @@ impl std::fmt::Display for SensitivityWarning {
             SensitivityWarning::NearFold {
                 sigma_min,
                 threshold,
-            } => write!(
-                f,
+            } => f.write_str(&warning!(
+                "fit.near-fold",
+                "Leave the rows near the fold out of the fit (range), or take the \
+                 intervals from the profile likelihood (profiles).",
                 "near a fold: the smallest singular value of I − M is {sigma_min:.3e} \
                  (< {threshold:.3e}); the sensitivities (I − M)⁻¹ ∂P/∂p are unreliable there"
-            ),
-            SensitivityWarning::Grazing { distance } => write!(
-                f,
+            )),
+            SensitivityWarning::Grazing { distance } => f.write_str(&warning!(
+                "fit.grazing",
+                "Leave the rows where the tip first touches out of the fit (range), or \
+                 take the intervals from the profile likelihood (profiles).",
                 "a grazing orbit (distance {distance:.3e} < {GRAZING_TOL:e} g₀): the \
                  stroboscopic map is not differentiable there, so the sensitivities of this \
                  row, and the standard errors drawn from them, are unreliable; leave the rows \
                  where the tip first touches out of the fit (`range`) or take the intervals \
                  from the profile likelihood (`profiles`), which needs no derivative"
-            ),
+            )),
         }
     }
 }

@@ -206,7 +206,9 @@ pub(crate) fn free_decay_warning<'a>(
 ) -> Option<String> {
     let k = points.filter(|p| p.free_decay_wait).count();
     (k > 0).then(|| {
-        format!(
+        warning!(
+            "curve.free-decay",
+            "Nothing: those points are right, only slower to compute.",
             "{k} point(s) waited for the free decay (their returns' contraction could not be \
              measured): they were settled by their time average only after the slowest free \
              mode decayed to the period test's tolerance, not as soon as their windows agreed \

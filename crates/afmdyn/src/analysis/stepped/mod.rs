@@ -643,7 +643,10 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
         .filter(|p| p.reached == Reached::Averaged)
         .count();
     if averaged > 0 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "curve.averaged",
+            "Read those points as time averages (no Floquet multipliers); raise \
+             max_period if their motion has a longer period.",
             "{averaged} point(s) averaged (no short period found): their motion did not repeat \
              with a period of at most {} drive periods, and was measured by its time average \
              once {AVERAGE_AGREEMENTS} successive windows agreed to {AVERAGE_TOL:e} of the \
@@ -654,7 +657,10 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
     warnings.extend(contraction::free_decay_warning(first.iter().chain(second)));
     let unsettled = first.iter().chain(second).filter(|p| p.unsettled()).count();
     if unsettled > 0 {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "curve.average-unsettled",
+            "Raise max_periods (a lever settles over ~Q periods), or read those points' \
+             error estimates in time_average.",
             "{unsettled} time-averaged point(s) did not settle within their transient cap (their \
              components' windows still differed by more than the tolerance): their values and \
              error estimates are those of the last windows{}",
@@ -672,7 +678,10 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
         .collect::<Vec<_>>()
         .join(", ");
     if spec.average.is_some() && spec.base.is_quasiperiodic() {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "curve.quasi-periodic-drive",
+            "Give the second drive a frequency at a ratio p/q with a small q for exact \
+             orbits; else read each point's error estimate in time_average.",
             "the drive's frequency ratio ({ratios}) repeats only after more than {} drive \
              periods (quasi-periodic): every point is a time average, with its error estimate \
              in time_average",
@@ -684,7 +693,10 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
             .iter()
             .chain(second)
             .find_map(|p| p.circle.as_ref().map(|c| c.nodes));
-        warnings.push(format!(
+        warnings.push(warning!(
+            "curve.invariant-circle",
+            "Nothing: invariant_circle says where the circle was used; a ratio with a \
+             smaller q gives exact orbits.",
             "the drive repeats only every {q} drive periods (its frequency ratio {ratios}): the \
              points are measured on the invariant circle of the stroboscopic map ({} nodes, \
              asked {}), the exact orbit where the circle is not smooth or not found{}",
@@ -701,7 +713,10 @@ fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint
         warnings.extend(torus::fallback_warning(&all));
     }
     if q > SLOW_COMMON_PERIODS && spec.average.is_none() && spec.torus.is_none() {
-        warnings.push(format!(
+        warnings.push(warning!(
+            "curve.long-period-drive",
+            "Give a ratio with a smaller q, or take the time average (bimodal --average), \
+             which does not depend on q.",
             "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
              {ratios}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 \
              f1) is as many times faster, and the time average (bimodal --average) does not \
@@ -738,7 +753,10 @@ fn continued_branches(
                 if let Some(why) = end.cause() {
                     // the curve's parameter is reported in the user's units by the front
                     // end: the warning names the cause, not the internal value
-                    warnings.push(format!(
+                    warnings.push(warning!(
+                        "curve.branch-ended",
+                        "Continue the branch from where it ended (continue --from) to \
+                         locate the folds beyond it.",
                         "a period-{} branch ended before the end of the range ({why}); \
                          folds beyond it are not located",
                         start.period.unwrap_or(1)

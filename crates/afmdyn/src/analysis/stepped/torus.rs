@@ -312,7 +312,10 @@ pub(super) fn fallback_warning(points: &[&CurvePoint]) -> Option<String> {
         .map(|(f, n)| format!("{n} {}", f.name()))
         .collect::<Vec<_>>()
         .join(", ");
-    Some(format!(
+    Some(warning!(
+        "curve.circle-fallback",
+        "Nothing: those points are exact orbits; invariant_circle.fallback gives each \
+         point's reason.",
         "{total} point(s) of the curve are the exact periodic orbit of the common period instead \
          of the invariant circle ({why}; not-smooth: a node near grazing, where a touch appears \
          at some phases of the second drive and not at others; skipped: not tried inside such \

@@ -6,13 +6,31 @@ use crate::layout::files::f;
 use crate::params::Params;
 use crate::report::Presentation;
 
+/// The columns of `converge.csv` with their unit and meaning (the book's reference of the CSV
+/// files shows them): τ, then one column per run, `{N}` its number of modes.
+pub(crate) const COLUMNS: [(&str, &str, &str); 2] = [
+    (
+        "tau_from_section",
+        "τ (eq. 5)",
+        "τ − τ0 from the first run's section point",
+    ),
+    (
+        "w_tip_n{N}",
+        "g0",
+        "tip deflection W(1,τ) of the run with modes = N",
+    ),
+];
+
 /// `converge`: `converge.csv` (W(1,τ) of every N over the common samples, τ from the first
 /// run's section point), the figure of paper Fig. 4 and the table of periods and RMS changes.
 pub(crate) fn converge(p: &Params, runs: &[ConvergenceRun]) -> Presentation {
     let mut s = Presentation::default();
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
-    let mut header = vec!["tau_from_section".to_string()];
-    header.extend(runs.iter().map(|r| format!("w_tip_n{}", r.modes)));
+    let mut header = vec![COLUMNS[0].0.to_string()];
+    header.extend(
+        runs.iter()
+            .map(|r| COLUMNS[1].0.replace("{N}", &r.modes.to_string())),
+    );
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     let t0 = runs.first().map_or(0.0, |r| r.tau[0]);
     let rows = (0..k)

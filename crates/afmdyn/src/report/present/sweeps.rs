@@ -238,7 +238,10 @@ impl SweepTally {
     #[cfg(feature = "files")]
     pub(crate) fn warning(&self) -> Option<String> {
         self.first_error.as_ref().map(|first| {
-            format!(
+            warning!(
+                "bifurcation.failed-points",
+                "Read the first failure's message; the failed points are missing from the \
+                 diagram.",
                 "{} of {} sweep points failed; the first: {first}",
                 self.errors,
                 self.periodic + self.nonperiodic + self.errors
