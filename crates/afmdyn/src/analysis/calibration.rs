@@ -371,7 +371,9 @@ fn peak_warnings(f: &[f64], o: &FitOutcome, m: &ThermalMode, floor: f64, top: f6
     let spacing = (f[f.len() - 1] - f[0]) / (f.len() - 1) as f64;
     let mut w = Vec::new();
     if f0 / q < 3.0 * spacing {
-        w.push(format!(
+        w.push(warning!(
+            "calibrate.unresolved-peak",
+            "Record a finer spectrum (a longer time record), or average more records.",
             "mode {}: the peak's width f0/Q = {} Hz is less than 3 frequency bins ({} Hz): Q and \
              the area are not resolved (a finer spectrum, or a longer record)",
             m.mode,
@@ -380,14 +382,18 @@ fn peak_warnings(f: &[f64], o: &FitOutcome, m: &ThermalMode, floor: f64, top: f6
         ));
     }
     if top < 3.0 * floor {
-        w.push(format!(
+        w.push(warning!(
+            "calibrate.weak-peak",
+            "Average more records, or check the detector's floor and the spot on the lever.",
             "mode {}: the peak rises only {:.2}× above its floor: the area is uncertain",
             m.mode,
             top / floor
         ));
     }
     if (f0 / m.frequency - 1.0).abs() > 0.3 {
-        w.push(format!(
+        w.push(warning!(
+            "calibrate.peak-far-from-mode",
+            "Check that the probe is the lever measured, or give the bands where each peak is.",
             "mode {}: the peak at {} Hz is more than 30 % from the probe's mode at {} Hz: is it \
              this mode's peak?",
             m.mode,

@@ -74,7 +74,10 @@ pub(crate) fn temperature_warnings(t: f64) -> Vec<String> {
     if (lo..=hi).contains(&t) {
         return Vec::new();
     }
-    vec![format!(
+    vec![warning!(
+        "thermal.temperature-unit",
+        "Give the temperature in kelvin (22 °C is 295.15 K); a cryogenic or heated stage's \
+         value stands.",
         "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
          in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
         t + 273.15

@@ -137,13 +137,16 @@ impl Analysis for CalibrateRequest {
         c.invols = measured;
         c.warnings = self.warnings();
         if probe.plan.is_none() {
-            c.warnings.push(
+            c.warnings.push(warning!(
+                "calibrate.no-plan",
+                "Give [cantilever] length and width (m) in the probe for Sader's method.",
                 "no Sader estimate: the probe does not give the lever's plan ([cantilever] \
                  length and width, m)"
-                    .into(),
-            );
+            ));
         } else if probe.calibration.tip_mass_ratio > 0.0 {
-            c.warnings.push(format!(
+            c.warnings.push(warning!(
+                "calibrate.sader-tip-mass",
+                "Read Sader's estimate as approximate; the thermal method's holds the tip mass.",
                 "Sader's method assumes a lever without a tip mass; the probe's is {} of the \
                  beam's",
                 crate::error::number(probe.calibration.tip_mass_ratio)
