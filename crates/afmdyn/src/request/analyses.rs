@@ -24,7 +24,7 @@ use crate::analysis::observables::Observables;
 use crate::analysis::period::MAX_PERIOD;
 use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
-use crate::error::SimError;
+use crate::error::{in_range, within, SimError};
 use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -36,12 +36,7 @@ mod start;
 pub use start::{initial_state, IntegratorRequest, StartRequest, SteadyRequest};
 
 fn check_period(period: Option<usize>) -> Result<(), SimError> {
-    match period {
-        Some(n) if !(1..=MAX_PERIOD).contains(&n) => {
-            Err(SimError::out_of_range("period", n, "must be in 1..=64"))
-        }
-        _ => Ok(()),
-    }
+    period.map_or(Ok(()), |n| in_range("period", n, 1..=MAX_PERIOD))
 }
 
 /// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
@@ -301,13 +296,12 @@ impl GlobalContinuationRequest {
         let values = match &self.values {
             Some(v) => v.clone(),
             None => {
-                if self.steps > MAX_CONTINUATION_VALUES {
-                    return Err(SimError::out_of_range(
-                        "steps",
-                        self.steps,
-                        "must be in 1..=10000",
-                    ));
-                }
+                within(
+                    "steps",
+                    self.steps,
+                    ..=MAX_CONTINUATION_VALUES,
+                    "must be in 1..=10000",
+                )?;
                 SweepSpec::linspace(self.from, self.to, self.steps)?
             }
         };
@@ -375,13 +369,7 @@ impl ObserveRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming `periods` or a steady-state option.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=MAX_OBSERVE_PERIODS).contains(&self.periods) {
-            return Err(SimError::out_of_range(
-                "periods",
-                self.periods,
-                "must be in 1..=1000000",
-            ));
-        }
+        in_range("periods", self.periods, 1..=MAX_OBSERVE_PERIODS)?;
         self.start.steady.options().map(|_| ())
     }
 }
@@ -441,13 +429,7 @@ impl ConvergeRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming the option.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=crate::params::MAX_MODES).contains(&self.max_modes) {
-            return Err(SimError::out_of_range(
-                "max_modes",
-                self.max_modes,
-                "must be in 1..=20",
-            ));
-        }
+        in_range("max_modes", self.max_modes, 1..=crate::params::MAX_MODES)?;
         check_samples_per_period(self.samples_per_period)?;
         if !(1..=MAX_CONVERGE_PERIODS).contains(&self.periods)
             || self.periods * self.samples_per_period > MAX_CONVERGE_SAMPLES
@@ -463,13 +445,7 @@ impl ConvergeRequest {
 }
 
 pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
-    if !(1..=MAX_SAMPLES_PER_PERIOD).contains(&spp) {
-        return Err(SimError::out_of_range(
-            "samples_per_period",
-            spp,
-            "must be in 1..=100000",
-        ));
-    }
+    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)?;
     Ok(())
 }
 

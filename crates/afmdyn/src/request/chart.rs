@@ -17,7 +17,7 @@ use super::model::{parameter, ModelSpec, ValueKind};
 use super::run::{Request, Resolved};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::chart::{CellParams, ChartSpec};
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::params::Params;
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
@@ -369,15 +369,8 @@ impl ChartRequest {
     /// not.
     fn check_options(&self) -> Result<(), SimError> {
         super::limits::check_threads(self.threads)?;
-        let steps = |name: &'static str, n: usize| {
-            if (1..=MAX_CHART_CELLS).contains(&n) {
-                Ok(())
-            } else {
-                Err(SimError::out_of_range(name, n, "must be in 1..=1000000"))
-            }
-        };
-        steps("x_steps", self.x_steps)?;
-        steps("y_steps", self.y_steps)?;
+        in_range("x_steps", self.x_steps, 1..=MAX_CHART_CELLS)?;
+        in_range("y_steps", self.y_steps, 1..=MAX_CHART_CELLS)?;
         let cells = self.x_steps.saturating_mul(self.y_steps);
         if cells > MAX_CHART_CELLS {
             return Err(SimError::out_of_range(
@@ -386,13 +379,7 @@ impl ChartRequest {
                 "must be <= 1000000 in all (fewer x_steps or y_steps)",
             ));
         }
-        if !(1..=MAX_CHART_STARTS).contains(&self.starts) {
-            return Err(SimError::out_of_range(
-                "starts",
-                self.starts,
-                "must be in 1..=1000",
-            ));
-        }
+        in_range("starts", self.starts, 1..=MAX_CHART_STARTS)?;
         if cells.saturating_mul(self.starts as usize) > MAX_CHART_RUNS {
             return Err(SimError::out_of_range(
                 "starts",
@@ -400,13 +387,7 @@ impl ChartRequest {
                 "must be <= 10000000 runs in all (fewer starts or cells)",
             ));
         }
-        if !(1..=MAX_CHART_TILE).contains(&self.tile) {
-            return Err(SimError::out_of_range(
-                "tile",
-                self.tile,
-                "must be in 1..=10000",
-            ));
-        }
+        in_range("tile", self.tile, 1..=MAX_CHART_TILE)?;
         if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
             return Err(SimError::out_of_range(
                 "cluster_tol",
@@ -423,13 +404,7 @@ impl ChartRequest {
                 "must be 0 (no λ₁) or in 10..=1000000",
             ));
         }
-        if !(1..=MAX_CHART_SLOTS).contains(&self.max_attractors) {
-            return Err(SimError::out_of_range(
-                "max_attractors",
-                self.max_attractors,
-                "must be in 1..=64",
-            ));
-        }
+        in_range("max_attractors", self.max_attractors, 1..=MAX_CHART_SLOTS)?;
         crate::error::finite("x_from", self.x_from)?;
         crate::error::finite("x_to", self.x_to)?;
         crate::error::finite("y_from", self.y_from)?;

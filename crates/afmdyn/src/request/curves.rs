@@ -9,7 +9,7 @@ use crate::analysis::stepped::average::AverageOptions;
 use crate::analysis::stepped::{
     Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
 };
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::model::CantileverModel;
 use crate::params::{Params, OMEGA_MAX, OMEGA_MIN};
 use serde::{Deserialize, Serialize};
@@ -145,13 +145,12 @@ impl CurveRequest {
         // the time average follows the motion in time: no periodic orbits to continue
         spec.branches = self.branches && spec.average.is_none();
         if let Some(n) = self.traces {
-            if !(2..=crate::analysis::traces::MAX_TRACE_SAMPLES).contains(&n) {
-                return Err(SimError::out_of_range(
-                    "traces",
-                    n,
-                    "must be in 2..=10000 samples per drive period",
-                ));
-            }
+            within(
+                "traces",
+                n,
+                2..=crate::analysis::traces::MAX_TRACE_SAMPLES,
+                "must be in 2..=10000 samples per drive period",
+            )?;
             // the worst case up front: every trace over MAX_TRACE_PERIODS periods
             let bytes = trace_bytes(spec.values.len(), n);
             if bytes > super::limits::MAX_TRACE_BYTES {

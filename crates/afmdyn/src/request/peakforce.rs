@@ -12,7 +12,7 @@ use crate::analysis::peakforce::{
     PeakForceOptions, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
     SETPOINT_ITERATIONS,
 };
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
@@ -126,13 +126,12 @@ impl PeakForceRequest {
                  0.5) to be off resonance",
             ));
         }
-        if !(MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES).contains(&self.samples) {
-            return Err(SimError::out_of_range(
-                "samples",
-                self.samples,
-                "must be in 2000..=1000000 (points of the reported cycle)",
-            ));
-        }
+        within(
+            "samples",
+            self.samples,
+            MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES,
+            "must be in 2000..=1000000 (points of the reported cycle)",
+        )?;
         self.options().validate()?;
         if let Some(fc) = self.filter_cutoff {
             // the cycle's sampling interval in the document's time unit (s with a probe), its
