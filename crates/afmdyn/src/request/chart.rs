@@ -12,9 +12,7 @@
 //! chart's axes and length unit where the chart runs.
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
-use super::limits::Cost;
 use super::model::{parameter, ModelSpec, ValueKind};
-use super::run::{Request, Resolved};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::chart::{CellParams, ChartSpec};
 use crate::error::{in_range, SimError};
@@ -459,19 +457,14 @@ pub(crate) fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError>
     super::costs::chart_cost(&chart.spec, chart.slots, &|x, y| chart.model.params(x, y))
 }
 
-/// A validated chart runs as an analysis ([`crate::request::run()`], Python's `afmdyn.chart`):
-/// its model is its own — [`ChartRequest::chart`](crate::request::ChartRequest::chart) built
-/// it from the request's model values, defaults and probe, validated every option and held
-/// its cost to the budgets — so the `model` given here is not read (pass
-/// [`Resolved::plain`] of any parameters). Its study runs in memory on its threads.
-impl Request for Chart {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn name(&self) -> &'static str {
-        "chart"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        chart_cost(self)
-    }
+impl_request! {
+    /// A validated chart runs as an analysis ([`crate::request::run()`], Python's
+    /// `afmdyn.chart`): its model is its own — [`ChartRequest::chart`] built it from the
+    /// request's model values, defaults and probe, validated every option and held its cost to
+    /// the budgets — so the `model` given here is not read (pass
+    /// [`Resolved::plain`](super::run::Resolved::plain) of any parameters). Its study runs in
+    /// memory on its threads.
+    Chart, "chart";
+    validate |_, _| Ok(());
+    cost |r, _| chart_cost(r)
 }
