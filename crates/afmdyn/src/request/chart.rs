@@ -336,13 +336,7 @@ impl ChartRequest {
         // the integrator's up-front budgets (steps per period, support of the law) at the
         // corners, as the attractor census checks them: an input error before any cell runs,
         // not every cell failing alike
-        let (xs, ys) = (&spec.x, &spec.y);
-        for (xv, yv) in [
-            (xs[0], ys[0]),
-            (xs[xs.len() - 1], ys[0]),
-            (xs[0], ys[ys.len() - 1]),
-            (xs[xs.len() - 1], ys[ys.len() - 1]),
-        ] {
+        for (xv, yv) in super::costs::corners(&spec) {
             crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
         }
         let fingerprint = fingerprint(self, &model);

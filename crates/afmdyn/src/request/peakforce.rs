@@ -8,11 +8,8 @@
 use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::limits::Cost;
 use super::run::Resolved;
-use crate::analysis::peakforce::{
-    PeakForceOptions, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
-    SETPOINT_ITERATIONS,
-};
-use crate::error::{within, SimError};
+use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, FIT_BAND, SETPOINT_ITERATIONS};
+use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
@@ -126,12 +123,6 @@ impl PeakForceRequest {
                  0.5) to be off resonance",
             ));
         }
-        within(
-            "samples",
-            self.samples,
-            MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES,
-            "must be in 2000..=1000000 (points of the reported cycle)",
-        )?;
         self.options().validate()?;
         if let Some(fc) = self.filter_cutoff {
             // the cycle's sampling interval in the document's time unit (s with a probe), its
