@@ -192,11 +192,7 @@ impl FmRequest {
             }
         }
         if length != 1.0 {
-            for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
-                if let Some(v) = v {
-                    super::limits::si_distance(name, v)?;
-                }
-            }
+            range.check_si_distances()?;
         }
         let base = model.params;
         if self.mode == 0 || self.mode > base.modes {
