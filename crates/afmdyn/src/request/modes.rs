@@ -47,7 +47,8 @@ impl_request! {
 /// `units`: a model's dimensionless set and its SI scales — of a probe file (`probe`:
 /// `{params, si}`, the probe's conversion alone, without the warnings a run's document
 /// carries), or of a physical model in the paper's terms (`physical`, eqs. 5, 7:
-/// `{params, scales, physical}`). Run on a plain model ([`Resolved::plain`]).
+/// `{params, scales, physical}`). Run on a plain model
+/// ([`Resolved::plain`](super::run::Resolved::plain)).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct UnitsRequest {
     /// The probe whose dimensionless set and scales are shown.
