@@ -467,6 +467,31 @@ impl SimError {
     }
 }
 
+/// Check that `value` lies in `range` (a NaN lies in none), naming `name` and what is
+/// `allowed` in the error.
+pub(crate) fn within<T: PartialOrd + ToString>(
+    name: &'static str,
+    value: T,
+    range: impl std::ops::RangeBounds<T>,
+    allowed: impl Into<std::borrow::Cow<'static, str>>,
+) -> Result<(), SimError> {
+    if range.contains(&value) {
+        Ok(())
+    } else {
+        Err(SimError::out_of_range(name, value, allowed))
+    }
+}
+
+/// [`within`] an inclusive range, the error spelling it: `must be in 1..=64`.
+pub(crate) fn in_range<T: PartialOrd + std::fmt::Display>(
+    name: &'static str,
+    value: T,
+    range: std::ops::RangeInclusive<T>,
+) -> Result<(), SimError> {
+    let allowed = format!("must be in {}..={}", range.start(), range.end());
+    within(name, value, range, allowed)
+}
+
 /// Check that `value` is finite, naming `name` in the error.
 pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SimError> {
     if value.is_finite() {

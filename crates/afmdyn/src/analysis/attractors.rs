@@ -12,7 +12,7 @@ use super::sequential::*;
 use super::shooting::{shoot, PeriodicOrbit, ShootingOptions};
 use super::steady::{steady_state_of, PoincarePoint, SteadyOptions, SteadyState};
 use crate::analysis::progress::Progress;
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
@@ -56,13 +56,7 @@ impl AttractorSpec {
     /// an integrator that cannot be built for the parameters
     /// ([`crate::integrate::check_buildable`]).
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=MAX_ATTRACTOR_SAMPLES).contains(&self.samples) {
-            return Err(SimError::out_of_range(
-                "samples",
-                self.samples,
-                "must be in 1..=100000",
-            ));
-        }
+        in_range("samples", self.samples, 1..=MAX_ATTRACTOR_SAMPLES)?;
         if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
             return Err(SimError::out_of_range(
                 "cluster_tol",

@@ -5,7 +5,7 @@
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
 use super::steady::{steady_state_of, SteadyOptions, SteadyState};
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::integrate::IntegratorOptions;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -131,13 +131,7 @@ impl SweepSpec {
     pub fn linspace(from: f64, to: f64, steps: usize) -> Result<Vec<f64>, SimError> {
         crate::error::finite("from", from)?;
         crate::error::finite("to", to)?;
-        if steps == 0 || steps > MAX_SWEEP_POINTS {
-            return Err(SimError::out_of_range(
-                "steps",
-                steps,
-                "must be in 1..=1000000",
-            ));
-        }
+        in_range("steps", steps, 1..=MAX_SWEEP_POINTS)?;
         if steps == 1 {
             return Ok(vec![from]);
         }

@@ -27,7 +27,7 @@ use super::attractors::{census, Attractor, AttractorSpec};
 use super::bifurcation::start_state;
 use super::progress::Progress;
 use super::steady::SteadyState;
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use nalgebra::DVector;
@@ -62,13 +62,7 @@ impl GlobalContinuationSpec {
     /// `samples` (values × samples ≤ `MAX_CONTINUATION_RUNS`) or `match_tol` (finite, ≥ 0);
     /// [`SimError::Params`] for a value outside the parameter's range.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=MAX_CONTINUATION_VALUES).contains(&self.values.len()) {
-            return Err(SimError::out_of_range(
-                "steps",
-                self.values.len(),
-                "must be in 1..=10000",
-            ));
-        }
+        in_range("steps", self.values.len(), 1..=MAX_CONTINUATION_VALUES)?;
         if self
             .values
             .len()

@@ -48,7 +48,7 @@ pub use setpoint::{
 use super::observables::{observe, ObservableOptions};
 use super::shooting::{broyden_pays, shoot, ShootingOptions, ShootingStrategy};
 use super::steady::{steady_state, Motion, SteadyOptions};
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::galerkin::Region;
 use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
 use crate::integrate::{Integrator, IntegratorOptions};
@@ -101,13 +101,12 @@ impl PeakForceOptions {
     /// # Errors
     /// [`SimError::OutOfRange`] naming the field.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES).contains(&self.samples) {
-            return Err(SimError::out_of_range(
-                "samples",
-                self.samples,
-                "must be in 2000..=1000000 (points of the reported cycle)",
-            ));
-        }
+        within(
+            "samples",
+            self.samples,
+            MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES,
+            "must be in 2000..=1000000 (points of the reported cycle)",
+        )?;
         let (lo, hi) = self.fit_band;
         if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo < hi && hi <= 1.0) {
             return Err(SimError::out_of_range(

@@ -3,7 +3,7 @@
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS_SETTLED};
 use super::shooting::{shoot, ShootingOptions};
-use crate::error::SimError;
+use crate::error::{in_range, within, SimError};
 use crate::galerkin::Region;
 use crate::integrate::{
     advance, advance_observed, build, Integrator, IntegratorOptions, Observed, Observer, Step,
@@ -403,28 +403,15 @@ impl SteadyOptions {
     /// [`SimError::OutOfRange`] naming `tol` ([`MIN_TOL`, `MAX_TOL`]), `max_period`
     /// (1..=64) or `max_periods` (1..=[`MAX_STEADY_PERIODS`]).
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(MIN_TOL..=MAX_TOL).contains(&self.tol) {
-            return Err(SimError::out_of_range(
-                "tol",
-                self.tol,
-                "must be in [1e-14, 1e-3]",
-            ));
-        }
-        if !(1..=MAX_PERIOD).contains(&self.max_period) {
-            return Err(SimError::out_of_range(
-                "max_period",
-                self.max_period,
-                "must be in 1..=64",
-            ));
-        }
+        within(
+            "tol",
+            self.tol,
+            MIN_TOL..=MAX_TOL,
+            "must be in [1e-14, 1e-3]",
+        )?;
+        in_range("max_period", self.max_period, 1..=MAX_PERIOD)?;
         if let Some(m) = self.max_periods {
-            if !(1..=MAX_STEADY_PERIODS).contains(&m) {
-                return Err(SimError::out_of_range(
-                    "max_periods",
-                    m,
-                    "must be in 1..=10000000",
-                ));
-            }
+            in_range("max_periods", m, 1..=MAX_STEADY_PERIODS)?;
         }
         Ok(())
     }

@@ -10,7 +10,7 @@
 //! points, at most `MAX_TRACE_PERIODS`), so the traces form arrays of shape
 //! `[points, periods × samples_per_period]` on one time axis.
 
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::integrate::{build, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -59,13 +59,12 @@ pub(crate) fn traces(
     points: &[TracePoint<'_>],
     samples_per_period: usize,
 ) -> Result<Traces, SimError> {
-    if !(2..=MAX_TRACE_SAMPLES).contains(&samples_per_period) {
-        return Err(SimError::out_of_range(
-            "trace_samples",
-            samples_per_period,
-            "must be in 2..=10000 samples per drive period",
-        ));
-    }
+    within(
+        "trace_samples",
+        samples_per_period,
+        2..=MAX_TRACE_SAMPLES,
+        "must be in 2..=10000 samples per drive period",
+    )?;
     let periods = points
         .iter()
         .map(|p| p.2.unwrap_or(1))

@@ -28,7 +28,7 @@
 //! [`CircleMap`] is a [`DiscreteMap`] whose fixed points are the circle's x_0: G(x_0) = x_0 +
 //! F(x_0), ∂G = I + ∂F, so the one Newton of [`crate::analysis::shooting::shoot`] solves it.
 
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::integrate::Integrator;
 use crate::maps::discrete::DiscreteMap;
 use crate::maps::flow::{flow, flow_state, grazing_distance, FlowMap};
@@ -83,13 +83,12 @@ impl CircleNodes {
         if q == 0 {
             return Err(SimError::out_of_range("q", 0, "must be ≥ 1"));
         }
-        if !(1..=MAX_NODES).contains(&m) {
-            return Err(SimError::out_of_range(
-                "nodes",
-                m,
-                "must be in 1..=1000 (drive periods per Newton iteration)",
-            ));
-        }
+        within(
+            "nodes",
+            m,
+            1..=MAX_NODES,
+            "must be in 1..=1000 (drive periods per Newton iteration)",
+        )?;
         let p = p % q;
         let angle =
             |k: u64| TAU * ((u128::from(k) * u128::from(p)) % u128::from(q)) as f64 / q as f64;

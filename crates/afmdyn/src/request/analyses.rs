@@ -11,7 +11,6 @@ use super::costs::{
     census_cost, newton_work, recorded_sample_bytes, state_bytes, steady_periods, MODEL_BYTES,
 };
 use super::limits::*;
-use super::run::{Request, Resolved};
 use super::sweep::SweepRecord;
 use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::bifurcation::SweepSpec;
@@ -24,7 +23,7 @@ use crate::analysis::observables::Observables;
 use crate::analysis::period::MAX_PERIOD;
 use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
-use crate::error::SimError;
+use crate::error::{in_range, within, SimError};
 use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -36,12 +35,7 @@ mod start;
 pub use start::{initial_state, IntegratorRequest, StartRequest, SteadyRequest};
 
 fn check_period(period: Option<usize>) -> Result<(), SimError> {
-    match period {
-        Some(n) if !(1..=MAX_PERIOD).contains(&n) => {
-            Err(SimError::out_of_range("period", n, "must be in 1..=64"))
-        }
-        _ => Ok(()),
-    }
+    period.map_or(Ok(()), |n| in_range("period", n, 1..=MAX_PERIOD))
 }
 
 /// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
@@ -301,13 +295,12 @@ impl GlobalContinuationRequest {
         let values = match &self.values {
             Some(v) => v.clone(),
             None => {
-                if self.steps > MAX_CONTINUATION_VALUES {
-                    return Err(SimError::out_of_range(
-                        "steps",
-                        self.steps,
-                        "must be in 1..=10000",
-                    ));
-                }
+                within(
+                    "steps",
+                    self.steps,
+                    ..=MAX_CONTINUATION_VALUES,
+                    "must be in 1..=10000",
+                )?;
                 SweepSpec::linspace(self.from, self.to, self.steps)?
             }
         };
@@ -375,13 +368,7 @@ impl ObserveRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming `periods` or a steady-state option.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=MAX_OBSERVE_PERIODS).contains(&self.periods) {
-            return Err(SimError::out_of_range(
-                "periods",
-                self.periods,
-                "must be in 1..=1000000",
-            ));
-        }
+        in_range("periods", self.periods, 1..=MAX_OBSERVE_PERIODS)?;
         self.start.steady.options().map(|_| ())
     }
 }
@@ -441,13 +428,7 @@ impl ConvergeRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming the option.
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(1..=crate::params::MAX_MODES).contains(&self.max_modes) {
-            return Err(SimError::out_of_range(
-                "max_modes",
-                self.max_modes,
-                "must be in 1..=20",
-            ));
-        }
+        in_range("max_modes", self.max_modes, 1..=crate::params::MAX_MODES)?;
         check_samples_per_period(self.samples_per_period)?;
         if !(1..=MAX_CONVERGE_PERIODS).contains(&self.periods)
             || self.periods * self.samples_per_period > MAX_CONVERGE_SAMPLES
@@ -463,13 +444,7 @@ impl ConvergeRequest {
 }
 
 pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
-    if !(1..=MAX_SAMPLES_PER_PERIOD).contains(&spp) {
-        return Err(SimError::out_of_range(
-            "samples_per_period",
-            spp,
-            "must be in 1..=100000",
-        ));
-    }
+    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)?;
     Ok(())
 }
 
@@ -562,19 +537,15 @@ impl BifurcationRequest {
     }
 }
 
-impl Request for BifurcationRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "bifurcation"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+impl_request! {
+    BifurcationRequest, "bifurcation";
+    validate |r, model| r.spec(&model.params).map(|_| ());
+    cost |r, model| {
         // every point (each value reached forward, backward and from each random start) and
         // each continued branch's coarse pass over its chunks (at most one point a value):
         // the steady-state search to its transient cap, then the recorded periods (one cycle
         // of up to max_period, or nonperiodic_record), whose Poincaré points are the records
-        let spec = self.spec(&model.params)?;
+        let spec = r.spec(&model.params)?;
         let p = &spec.base;
         let values = spec.values.len() as f64;
         let points = super::sweep::point_count(&spec) as f64;
@@ -593,18 +564,13 @@ impl Request for BifurcationRequest {
     }
 }
 
-impl Request for GlobalContinuationRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer steps or samples (random starts), or a shorter transient (max_periods)";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "attractors --sweep"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // one census per value
-        let spec = self.spec(&model.params)?;
+impl_request! {
+    GlobalContinuationRequest, "attractors --sweep",
+    advice = "ask for fewer steps or samples (random starts), or a shorter transient (max_periods)";
+    validate |r, model| r.spec(&model.params).map(|_| ());
+    // one census per value
+    cost |r, model| {
+        let spec = r.spec(&model.params)?;
         census_cost(&spec.census, spec.values.len())
     }
 }
@@ -614,21 +580,16 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 #[cfg(test)]
 mod tests;
 
-impl Request for OrbitRequest {
-    const COST_ADVICE: &'static str =
-        "ask for a shorter transient (max_periods) or a lower max_period";
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        OrbitRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "orbit"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the steady state from rest (without an initial state), then Newton on the period
-        // asked for or the largest one searched
+impl_request! {
+    OrbitRequest, "orbit",
+    advice = "ask for a shorter transient (max_periods) or a lower max_period";
+    validate |r, _| OrbitRequest::validate(r);
+    // the steady state from rest (without an initial state), then Newton on the period asked
+    // for or the largest one searched
+    cost |r, model| {
         let p = &model.params;
-        let (search, steady) = start_work(&self.start, p)?;
-        let period = self.period.unwrap_or(steady.max_period);
+        let (search, steady) = start_work(&r.start, p)?;
+        let period = r.period.unwrap_or(steady.max_period);
         Ok(Cost {
             bytes: MODEL_BYTES,
             work: search + newton_work(p, period, &ShootingOptions::default()),
@@ -636,24 +597,18 @@ impl Request for OrbitRequest {
     }
 }
 
-impl Request for ContinuationRequest {
-    const COST_ADVICE: &'static str =
-        "ask for a shorter range (from, to) or a shorter transient (max_periods)";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        ContinuationRequest::validate(self, &model.params)
-    }
-    fn name(&self) -> &'static str {
-        "continuation"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the start's steady state, then up to max_points Newton solves per branch (the
-        // cascade: branches of periods n, 2n, 4n, 8n with switching), each point's state and
-        // monodromy kept
+impl_request! {
+    ContinuationRequest, "continuation",
+    advice = "ask for a shorter range (from, to) or a shorter transient (max_periods)";
+    validate |r, model| ContinuationRequest::validate(r, &model.params);
+    // the start's steady state, then up to max_points Newton solves per branch (the cascade:
+    // branches of periods n, 2n, 4n, 8n with switching), each point's state and monodromy kept
+    cost |r, model| {
         let p = &model.params;
-        let (search, steady) = start_work(&self.start, &p.with(self.param, self.from))?;
-        let n = self.period.unwrap_or(steady.max_period);
-        let points = ContinuationSpec::new(*p, self.param, self.from, self.to, n).max_points;
-        let (branches, top) = match self.switch {
+        let (search, steady) = start_work(&r.start, &p.with(r.param, r.from))?;
+        let n = r.period.unwrap_or(steady.max_period);
+        let points = ContinuationSpec::new(*p, r.param, r.from, r.to, n).max_points;
+        let (branches, top) = match r.switch {
             true => (4.0, CASCADE_FACTOR * n),
             false => (1.0, n),
         };
@@ -666,82 +621,57 @@ impl Request for ContinuationRequest {
     }
 }
 
-impl Request for LyapunovRequest {
-    const COST_ADVICE: &'static str = "ask for fewer periods or a shorter transient";
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        LyapunovRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "lyapunov"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the transient and the averaged periods of the state and its tangent space (one
-        // column per state dimension); one value per block and exponent kept
+impl_request! {
+    LyapunovRequest, "lyapunov", advice = "ask for fewer periods or a shorter transient";
+    validate |r, _| LyapunovRequest::validate(r);
+    // the transient and the averaged periods of the state and its tangent space (one column
+    // per state dimension); one value per block and exponent kept
+    cost |r, model| {
         let p = &model.params;
-        let transient = match self.transient {
+        let transient = match r.transient {
             Some(t) => t as f64,
             None => steady_periods(&SteadyOptions::default(), p)?,
         };
         let dim = p.state_dim() as f64;
         Ok(Cost {
-            bytes: MODEL_BYTES + self.blocks as f64 * state_bytes(p),
-            work: (transient + self.periods as f64) * (dim + 1.0) * p.modes as f64,
+            bytes: MODEL_BYTES + r.blocks as f64 * state_bytes(p),
+            work: (transient + r.periods as f64) * (dim + 1.0) * p.modes as f64,
         })
     }
 }
 
-impl Request for AttractorsRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer samples (random starts) or a shorter transient (max_periods)";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "attractors"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        let spec = self.spec(&model.params)?;
-        census_cost(&spec, 1)
-    }
+impl_request! {
+    AttractorsRequest, "attractors",
+    advice = "ask for fewer samples (random starts) or a shorter transient (max_periods)";
+    validate |r, model| r.spec(&model.params).map(|_| ());
+    cost |r, model| census_cost(&r.spec(&model.params)?, 1)
 }
 
-impl Request for ObserveRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer periods or harmonics, or a shorter transient (max_periods)";
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        ObserveRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "observe"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // the start's steady state, Newton on its period (at most the largest searched), then
-        // `periods` of that period; the harmonics' amplitudes and phases kept
+impl_request! {
+    ObserveRequest, "observe",
+    advice = "ask for fewer periods or harmonics, or a shorter transient (max_periods)";
+    validate |r, _| ObserveRequest::validate(r);
+    // the start's steady state, Newton on its period (at most the largest searched), then
+    // `periods` of that period; the harmonics' amplitudes and phases kept
+    cost |r, model| {
         let p = &model.params;
-        let (search, steady) = start_work(&self.start, p)?;
+        let (search, steady) = start_work(&r.start, p)?;
         let n = steady.max_period;
         let newton = ShootingOptions {
             tol: 1e-12,
             ..ShootingOptions::default()
         };
         Ok(Cost {
-            bytes: MODEL_BYTES + self.harmonics as f64 * 32.0,
-            work: search + newton_work(p, n, &newton) + (self.periods * n) as f64 * p.modes as f64,
+            bytes: MODEL_BYTES + r.harmonics as f64 * 32.0,
+            work: search + newton_work(p, n, &newton) + (r.periods * n) as f64 * p.modes as f64,
         })
     }
 }
 
-impl Request for ConvergeRequest {
-    const COST_ADVICE: &'static str = "ask for fewer max_modes, periods or samples_per_period";
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        ConvergeRequest::validate(self)
-    }
-    fn name(&self) -> &'static str {
-        "converge"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        converge_cost(self, &model.params)
-    }
+impl_request! {
+    ConvergeRequest, "converge", advice = "ask for fewer max_modes, periods or samples_per_period";
+    validate |r, _| ConvergeRequest::validate(r);
+    cost |r, model| converge_cost(r, &model.params)
 }
 
 /// The mode-periods of the steady-state search of a start on `params` (none when it gives its

@@ -5,8 +5,6 @@
 
 use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
 use super::costs::basins_cost;
-use super::limits::Cost;
-use super::run::{Request, Resolved};
 use crate::analysis::basins::{
     BasinSpec, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER,
     DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
@@ -168,16 +166,9 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
     }
 }
 
-impl Request for BasinsRequest {
-    const COST_ADVICE: &'static str =
-        "ask for fewer cells (x_steps × y_steps) or a shorter transient (max_periods)";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "basins"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        basins_cost(&self.spec(&model.params)?)
-    }
+impl_request! {
+    BasinsRequest, "basins",
+    advice = "ask for fewer cells (x_steps × y_steps) or a shorter transient (max_periods)";
+    validate |r, model| r.spec(&model.params).map(|_| ());
+    cost |r, model| basins_cost(&r.spec(&model.params)?)
 }

@@ -12,12 +12,10 @@
 //! chart's axes and length unit where the chart runs.
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
-use super::limits::Cost;
 use super::model::{parameter, ModelSpec, ValueKind};
-use super::run::{Request, Resolved};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::chart::{CellParams, ChartSpec};
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::params::Params;
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
@@ -338,13 +336,7 @@ impl ChartRequest {
         // the integrator's up-front budgets (steps per period, support of the law) at the
         // corners, as the attractor census checks them: an input error before any cell runs,
         // not every cell failing alike
-        let (xs, ys) = (&spec.x, &spec.y);
-        for (xv, yv) in [
-            (xs[0], ys[0]),
-            (xs[xs.len() - 1], ys[0]),
-            (xs[0], ys[ys.len() - 1]),
-            (xs[xs.len() - 1], ys[ys.len() - 1]),
-        ] {
+        for (xv, yv) in super::costs::corners(&spec) {
             crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
         }
         let fingerprint = fingerprint(self, &model);
@@ -369,15 +361,8 @@ impl ChartRequest {
     /// not.
     fn check_options(&self) -> Result<(), SimError> {
         super::limits::check_threads(self.threads)?;
-        let steps = |name: &'static str, n: usize| {
-            if (1..=MAX_CHART_CELLS).contains(&n) {
-                Ok(())
-            } else {
-                Err(SimError::out_of_range(name, n, "must be in 1..=1000000"))
-            }
-        };
-        steps("x_steps", self.x_steps)?;
-        steps("y_steps", self.y_steps)?;
+        in_range("x_steps", self.x_steps, 1..=MAX_CHART_CELLS)?;
+        in_range("y_steps", self.y_steps, 1..=MAX_CHART_CELLS)?;
         let cells = self.x_steps.saturating_mul(self.y_steps);
         if cells > MAX_CHART_CELLS {
             return Err(SimError::out_of_range(
@@ -386,13 +371,7 @@ impl ChartRequest {
                 "must be <= 1000000 in all (fewer x_steps or y_steps)",
             ));
         }
-        if !(1..=MAX_CHART_STARTS).contains(&self.starts) {
-            return Err(SimError::out_of_range(
-                "starts",
-                self.starts,
-                "must be in 1..=1000",
-            ));
-        }
+        in_range("starts", self.starts, 1..=MAX_CHART_STARTS)?;
         if cells.saturating_mul(self.starts as usize) > MAX_CHART_RUNS {
             return Err(SimError::out_of_range(
                 "starts",
@@ -400,13 +379,7 @@ impl ChartRequest {
                 "must be <= 10000000 runs in all (fewer starts or cells)",
             ));
         }
-        if !(1..=MAX_CHART_TILE).contains(&self.tile) {
-            return Err(SimError::out_of_range(
-                "tile",
-                self.tile,
-                "must be in 1..=10000",
-            ));
-        }
+        in_range("tile", self.tile, 1..=MAX_CHART_TILE)?;
         if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
             return Err(SimError::out_of_range(
                 "cluster_tol",
@@ -423,13 +396,7 @@ impl ChartRequest {
                 "must be 0 (no λ₁) or in 10..=1000000",
             ));
         }
-        if !(1..=MAX_CHART_SLOTS).contains(&self.max_attractors) {
-            return Err(SimError::out_of_range(
-                "max_attractors",
-                self.max_attractors,
-                "must be in 1..=64",
-            ));
-        }
+        in_range("max_attractors", self.max_attractors, 1..=MAX_CHART_SLOTS)?;
         crate::error::finite("x_from", self.x_from)?;
         crate::error::finite("x_to", self.x_to)?;
         crate::error::finite("y_from", self.y_from)?;
@@ -484,19 +451,14 @@ pub(crate) fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError>
     super::costs::chart_cost(&chart.spec, chart.slots, &|x, y| chart.model.params(x, y))
 }
 
-/// A validated chart runs as an analysis ([`crate::request::run()`], Python's `afmdyn.chart`):
-/// its model is its own — [`ChartRequest::chart`](crate::request::ChartRequest::chart) built
-/// it from the request's model values, defaults and probe, validated every option and held
-/// its cost to the budgets — so the `model` given here is not read (pass
-/// [`Resolved::plain`] of any parameters). Its study runs in memory on its threads.
-impl Request for Chart {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn name(&self) -> &'static str {
-        "chart"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        chart_cost(self)
-    }
+impl_request! {
+    /// A validated chart runs as an analysis ([`crate::request::run()`], Python's
+    /// `afmdyn.chart`): its model is its own — [`ChartRequest::chart`] built it from the
+    /// request's model values, defaults and probe, validated every option and held its cost to
+    /// the budgets — so the `model` given here is not read (pass
+    /// [`Resolved::plain`](super::run::Resolved::plain) of any parameters). Its study runs in
+    /// memory on its threads.
+    Chart, "chart";
+    validate |_, _| Ok(());
+    cost |r, _| chart_cost(r)
 }

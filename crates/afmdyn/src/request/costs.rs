@@ -225,12 +225,7 @@ pub(crate) fn chart_cost(
 ) -> Result<Cost, SimError> {
     let (xs, ys) = (&spec.x, &spec.y);
     let mut cap: f64 = 0.0;
-    for (x, y) in [
-        (xs[0], ys[0]),
-        (xs[xs.len() - 1], ys[0]),
-        (xs[0], ys[ys.len() - 1]),
-        (xs[xs.len() - 1], ys[ys.len() - 1]),
-    ] {
+    for (x, y) in corners(spec) {
         let p = params(x, y)?;
         let periods = steady_periods(&spec.steady, &p)? + 2.0 * spec.lyapunov_periods as f64;
         cap = cap.max(periods * p.modes as f64);
@@ -241,6 +236,14 @@ pub(crate) fn chart_cost(
         bytes: MODEL_BYTES + cells * (128.0 + slots as f64 * (128.0 + 80.0)),
         work: runs * cap,
     })
+}
+
+/// The four corners (x, y) of a chart of `spec`: where its cost and its integrator are checked
+/// (a model's decay rates vary monotonically along each axis).
+pub(crate) fn corners(spec: &crate::analysis::chart::ChartSpec) -> [(f64, f64); 4] {
+    let (xs, ys) = (&spec.x, &spec.y);
+    let (x1, y1) = (xs[xs.len() - 1], ys[ys.len() - 1]);
+    [(xs[0], ys[0]), (x1, ys[0]), (xs[0], y1), (x1, y1)]
 }
 
 /// The cost of an image's approach curves ([`crate::request::image`]): one curve of

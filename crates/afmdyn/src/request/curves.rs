@@ -9,7 +9,7 @@ use crate::analysis::stepped::average::AverageOptions;
 use crate::analysis::stepped::{
     Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
 };
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::model::CantileverModel;
 use crate::params::{Params, OMEGA_MAX, OMEGA_MIN};
 use serde::{Deserialize, Serialize};
@@ -92,12 +92,23 @@ impl CurveRequest {
     /// # Errors
     /// [`SimError::NotFinite`] naming `from`, `to` or `step`.
     pub(crate) fn check_finite(&self) -> Result<(), SimError> {
-        for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
-            if let Some(x) = v {
-                crate::error::finite(name, x)?;
-            }
-        }
-        Ok(())
+        self.given()
+            .try_for_each(|(name, v)| crate::error::finite(name, v).map(|_| ()))
+    }
+
+    /// The given ends and step, by name.
+    fn given(&self) -> impl Iterator<Item = (&'static str, f64)> {
+        let named = [("from", self.from), ("to", self.to), ("step", self.step)];
+        named.into_iter().filter_map(|(name, v)| Some((name, v?)))
+    }
+
+    /// The given ends and step as distances in m ([`super::limits::si_distance`]).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `from`, `to` or `step`.
+    pub(crate) fn check_si_distances(&self) -> Result<(), SimError> {
+        self.given()
+            .try_for_each(|(name, v)| super::limits::si_distance(name, v))
     }
 
     /// The ends in dimensionless units: the requested ones divided by `unit`, else `default`.
@@ -145,13 +156,12 @@ impl CurveRequest {
         // the time average follows the motion in time: no periodic orbits to continue
         spec.branches = self.branches && spec.average.is_none();
         if let Some(n) = self.traces {
-            if !(2..=crate::analysis::traces::MAX_TRACE_SAMPLES).contains(&n) {
-                return Err(SimError::out_of_range(
-                    "traces",
-                    n,
-                    "must be in 2..=10000 samples per drive period",
-                ));
-            }
+            within(
+                "traces",
+                n,
+                2..=crate::analysis::traces::MAX_TRACE_SAMPLES,
+                "must be in 2..=10000 samples per drive period",
+            )?;
             // the worst case up front: every trace over MAX_TRACE_PERIODS periods
             let bytes = trace_bytes(spec.values.len(), n);
             if bytes > super::limits::MAX_TRACE_BYTES {
@@ -187,15 +197,7 @@ pub fn approach_request(
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
     if length != 1.0 {
-        for (name, v) in [
-            ("from", request.from),
-            ("to", request.to),
-            ("step", request.step),
-        ] {
-            if let Some(v) = v {
-                super::limits::si_distance(name, v)?;
-            }
-        }
+        request.check_si_distances()?;
     }
     let (from, to) = request.ends(default_range(&base)?, length);
     let mut spec =

@@ -7,7 +7,7 @@
 use super::costs::{newton_work, state_bytes, MODEL_BYTES};
 use super::curves::CurveRequest;
 use super::limits::Cost;
-use super::run::{Request, Resolved};
+use super::run::Resolved;
 use crate::analysis::approach::approach_spec;
 use crate::analysis::fm::FmSpec;
 use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
@@ -192,11 +192,7 @@ impl FmRequest {
             }
         }
         if length != 1.0 {
-            for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
-                if let Some(v) = v {
-                    super::limits::si_distance(name, v)?;
-                }
-            }
+            range.check_si_distances()?;
         }
         let base = model.params;
         if self.mode == 0 || self.mode > base.modes {
@@ -228,22 +224,16 @@ impl FmRequest {
     }
 }
 
-impl Request for FmRequest {
-    const COST_ADVICE: &'static str = "ask for fewer points";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+impl_request! {
+    FmRequest, "fm", advice = "ask for fewer points", needs = Tapping;
+    validate |r, model| {
         super::curves::check_single_frequency(&model.params, "fm")?;
-        self.spec(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "fm"
-    }
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Tapping
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // every z_c: up to MAX_LOOP_ITERATIONS × MAX_HALVINGS steps of the phase loop, each a
-        // Newton solve of the period-1 orbit; a point's orbit and observables kept
-        let spec = self.spec(model)?;
+        r.spec(model).map(|_| ())
+    };
+    // every z_c: up to MAX_LOOP_ITERATIONS × MAX_HALVINGS steps of the phase loop, each a
+    // Newton solve of the period-1 orbit; a point's orbit and observables kept
+    cost |r, model| {
+        let spec = r.spec(model)?;
         let p = &spec.base;
         let points = spec.values.len() as f64;
         let steps = (MAX_LOOP_ITERATIONS * MAX_HALVINGS) as f64;

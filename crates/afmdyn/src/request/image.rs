@@ -16,7 +16,7 @@
 //! file (feature `files`: [`crate::io::height_map`]), a relative path taken from the sample
 //! file's directory ([`SampleMap::load`]) or else the current directory ([`SampleMap::parse`]).
 
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
@@ -169,21 +169,9 @@ impl ImageRequest {
     /// [`SimError::OutOfRange`] naming `pixels`, `lines` (1..=4096; 1 for a line map) or
     /// `curve_points` (8..=2000); [`SimError::Budget`] for an image over `MAX_IMAGE_BYTES`.
     pub fn validate_grid(&self, map: &SampleMap) -> Result<(), SimError> {
-        if !(1..=MAX_PIXELS).contains(&self.pixels) {
-            return Err(SimError::out_of_range(
-                "pixels",
-                self.pixels,
-                "must be in 1..=4096",
-            ));
-        }
+        in_range("pixels", self.pixels, 1..=MAX_PIXELS)?;
         let lines = self.lines(map);
-        if !(1..=MAX_PIXELS).contains(&lines) {
-            return Err(SimError::out_of_range(
-                "lines",
-                lines,
-                "must be in 1..=4096",
-            ));
-        }
+        in_range("lines", lines, 1..=MAX_PIXELS)?;
         if map.size.1 == 0.0 && lines != 1 {
             return Err(SimError::out_of_range(
                 "lines",
@@ -191,13 +179,7 @@ impl ImageRequest {
                 "must be 1 for a line map (size = [Lx, 0])",
             ));
         }
-        if !(8..=2000).contains(&self.curve_points) {
-            return Err(SimError::out_of_range(
-                "curve_points",
-                self.curve_points,
-                "must be in 8..=2000",
-            ));
-        }
+        in_range("curve_points", self.curve_points, 8..=2000)?;
         // the image held in memory with its document: measured 920 B a pixel (RSS of a
         // 512 × 512 blend image, 241 MB), checked before any work
         let bytes = self.pixel_bytes(map);

@@ -11,7 +11,7 @@ use super::image_scan::PiScan;
 #[cfg(feature = "files")]
 use super::image_scan::ScanRecipe;
 use super::limits::{check_threads, Cost};
-use super::run::{Request, Resolved};
+use super::run::Resolved;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
 
@@ -162,39 +162,35 @@ impl ImageJob {
     }
 }
 
-impl Request for ImageJob {
-    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
-        self.request.validate(&self.sample)?;
-        check_threads(self.threads)?;
-        if self.mode == ImageMode::Peakforce {
-            return self.validate_peakforce();
+impl_request! {
+    ImageJob, "image";
+    validate |r, _| {
+        r.request.validate(&r.sample)?;
+        check_threads(r.threads)?;
+        if r.mode == ImageMode::Peakforce {
+            return r.validate_peakforce();
         }
-        let background = background_probe(&self.probe)?;
+        let background = background_probe(&r.probe)?;
         background.serves("image --mode am", crate::probe::ProbeNeeds::Tapping)?;
-        match (&self.feedback, &self.study) {
+        match (&r.feedback, &r.study) {
             (Some(_), Some(_)) => Err(SimError::out_of_range(
                 "setpoint_study",
                 "a study with the PI feedback",
                 "only with the ideal feedback (a study of exact operating points)",
             )),
             (Some(scan), None) => {
-                resolve(&background, &self.sample, &self.request, scan).map(|_| ())
+                resolve(&background, &r.sample, &r.request, scan).map(|_| ())
             }
             (None, _) => Ok(()),
         }
-    }
-
-    fn name(&self) -> &'static str {
-        "image"
-    }
-
-    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
-        if self.mode == ImageMode::Peakforce {
-            return peakforce_cost(&self.probe, &self.sample, &self.request);
+    };
+    cost |r, _| {
+        if r.mode == ImageMode::Peakforce {
+            return peakforce_cost(&r.probe, &r.sample, &r.request);
         }
-        let background = background_probe(&self.probe)?;
-        let (map, req) = (&self.sample, &self.request);
-        let periods = match &self.feedback {
+        let background = background_probe(&r.probe)?;
+        let (map, req) = (&r.sample, &r.request);
+        let periods = match &r.feedback {
             Some(scan) => resolve(&background, map, req, scan)?.2,
             None => 0.0,
         };
@@ -203,7 +199,7 @@ impl Request for ImageJob {
             work: periods,
         };
         let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
-        if self.study.is_some() {
+        if r.study.is_some() {
             // the study computes the materials' curves once more
             let none = Cost {
                 bytes: 0.0,

@@ -30,8 +30,6 @@ pub use crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES;
 pub use crate::analysis::steady::MAX_STEADY_PERIODS;
 /// Largest number of worker threads a sweep may ask for.
 pub const MAX_THREADS: usize = 1024;
-// the bound as `check_threads`'s message spells it
-const _: () = assert!(MAX_THREADS == 1024);
 
 /// A request's thread count (`None`: all cores) checked against 1..=[`MAX_THREADS`]: the one
 /// rule of every study's `threads`.
@@ -39,14 +37,9 @@ const _: () = assert!(MAX_THREADS == 1024);
 /// # Errors
 /// [`crate::SimError::OutOfRange`] naming `threads`.
 pub(crate) fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
-    match threads {
-        Some(t) if !(1..=MAX_THREADS).contains(&t) => Err(crate::SimError::out_of_range(
-            "threads",
-            t,
-            "must be in 1..=1024",
-        )),
-        _ => Ok(()),
-    }
+    threads.map_or(Ok(()), |t| {
+        crate::error::in_range("threads", t, 1..=MAX_THREADS)
+    })
 }
 /// What a request costs ([`crate::request::Request::cost`]), estimated before it runs for the
 /// worst case its options allow (`crate::request::costs`).

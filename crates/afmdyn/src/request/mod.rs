@@ -27,6 +27,52 @@
 //!
 //! [`Params`]: crate::Params
 
+/// `impl Request for TYPE` of a request whose methods are one expression each: its name, its
+/// `COST_ADVICE` and `probe_needs` where they are not the trait's defaults, and the bodies of
+/// `validate`, `cost` and (where it is not the model's parameters) `computed_at`, each over
+/// the request and its model (`|r, model|`).
+macro_rules! impl_request {
+    (
+        $(#[$attr:meta])*
+        $t:ty, $name:literal $(, advice = $advice:expr)? $(, needs = $needs:ident)?;
+        validate |$vr:pat_param, $vm:pat_param| $validate:expr;
+        cost |$cr:pat_param, $cm:pat_param| $cost:expr
+        $(; computed_at |$ar:pat_param, $am:pat_param| $at:expr)? $(;)?
+    ) => {
+        $(#[$attr])*
+        impl $crate::request::run::Request for $t {
+            $(const COST_ADVICE: &'static str = $advice;)?
+            fn validate(
+                &self,
+                model: &$crate::request::run::Resolved,
+            ) -> Result<(), $crate::error::SimError> {
+                let ($vr, $vm) = (self, model);
+                $validate
+            }
+            fn name(&self) -> &'static str {
+                $name
+            }
+            $(fn probe_needs(&self) -> $crate::probe::ProbeNeeds {
+                $crate::probe::ProbeNeeds::$needs
+            })?
+            fn cost(
+                &self,
+                model: &$crate::request::run::Resolved,
+            ) -> Result<$crate::request::limits::Cost, $crate::error::SimError> {
+                let ($cr, $cm) = (self, model);
+                $cost
+            }
+            $(fn computed_at(
+                &self,
+                model: &$crate::request::run::Resolved,
+            ) -> Result<$crate::params::Params, $crate::error::SimError> {
+                let ($ar, $am) = (self, model);
+                $at
+            })?
+        }
+    };
+}
+
 pub mod analyses;
 pub mod basins;
 pub mod calibrate;

@@ -4,8 +4,6 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
-use super::run::{Request, Resolved};
-use crate::error::SimError;
 use crate::units::PhysicalModel;
 use serde::{Deserialize, Serialize};
 
@@ -22,17 +20,11 @@ const NO_WORK: Cost = Cost {
 #[serde(deny_unknown_fields)]
 pub struct ModesRequest {}
 
-impl Request for ModesRequest {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        Ok(model.params.validate_fields()?)
-    }
-    fn name(&self) -> &'static str {
-        "modes"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        // two eigenproblems of 2N × 2N: no integration
-        Ok(NO_WORK)
-    }
+// two eigenproblems of 2N × 2N: no integration
+impl_request! {
+    ModesRequest, "modes";
+    validate |_, model| Ok(model.params.validate_fields()?);
+    cost |_, _| Ok(NO_WORK)
 }
 
 /// `modes --sweep fig3`: the paper's Fig. 3 maps, ω₁/ω₀₁ and ω₂/ω₀₂ of the contact system
@@ -45,23 +37,18 @@ pub struct Fig3Request {
     pub out: String,
 }
 
-impl Request for Fig3Request {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        Ok(model.params.validate_fields()?)
-    }
-    fn name(&self) -> &'static str {
-        "modes"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        // 11 × 101 eigenproblems of 2N × 2N: no integration
-        Ok(NO_WORK)
-    }
+// 11 × 101 eigenproblems of 2N × 2N: no integration
+impl_request! {
+    Fig3Request, "modes";
+    validate |_, model| Ok(model.params.validate_fields()?);
+    cost |_, _| Ok(NO_WORK)
 }
 
 /// `units`: a model's dimensionless set and its SI scales — of a probe file (`probe`:
 /// `{params, si}`, the probe's conversion alone, without the warnings a run's document
 /// carries), or of a physical model in the paper's terms (`physical`, eqs. 5, 7:
-/// `{params, scales, physical}`). Run on a plain model ([`Resolved::plain`]).
+/// `{params, scales, physical}`). Run on a plain model
+/// ([`Resolved::plain`](super::run::Resolved::plain)).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct UnitsRequest {
     /// The probe whose dimensionless set and scales are shown.
@@ -70,16 +57,10 @@ pub struct UnitsRequest {
     pub physical: Option<PhysicalModel>,
 }
 
-impl Request for UnitsRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn name(&self) -> &'static str {
-        "units"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        Ok(NO_WORK)
-    }
+impl_request! {
+    UnitsRequest, "units";
+    validate |_, _| Ok(());
+    cost |_, _| Ok(NO_WORK)
 }
 
 /// `cantilevers`: the lever library (nominal k, f₀, Q and tip radius, with their sources;
@@ -87,14 +68,8 @@ impl Request for UnitsRequest {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CantileversRequest {}
 
-impl Request for CantileversRequest {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        Ok(())
-    }
-    fn name(&self) -> &'static str {
-        "cantilevers"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        Ok(NO_WORK)
-    }
+impl_request! {
+    CantileversRequest, "cantilevers";
+    validate |_, _| Ok(());
+    cost |_, _| Ok(NO_WORK)
 }

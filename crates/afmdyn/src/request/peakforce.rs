@@ -7,11 +7,8 @@
 
 use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::limits::Cost;
-use super::run::{Request, Resolved};
-use crate::analysis::peakforce::{
-    PeakForceOptions, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
-    SETPOINT_ITERATIONS,
-};
+use super::run::Resolved;
+use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, FIT_BAND, SETPOINT_ITERATIONS};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -124,13 +121,6 @@ impl PeakForceRequest {
                 p.omega,
                 "the modulation must lie below half the lever's first resonance (f_m/f₀ ≤ \
                  0.5) to be off resonance",
-            ));
-        }
-        if !(MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES).contains(&self.samples) {
-            return Err(SimError::out_of_range(
-                "samples",
-                self.samples,
-                "must be in 2000..=1000000 (points of the reported cycle)",
             ));
         }
         self.options().validate()?;
@@ -312,32 +302,27 @@ impl PeakForceRequest {
     }
 }
 
-impl Request for PeakForceRequest {
-    const COST_ADVICE: &'static str = "ask for fewer samples or sweep values";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.params(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "peakforce"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // every tap: the transient (at most its cap) and Newton's variational flows, each drive
-        // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle
-        // and the fit's resampling kept
-        let p = self.params(model)?;
-        let opts = self.options();
+impl_request! {
+    PeakForceRequest, "peakforce", advice = "ask for fewer samples or sweep values";
+    validate |r, model| r.params(model).map(|_| ());
+    // every tap: the transient (at most its cap) and Newton's variational flows, each drive
+    // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle and
+    // the fit's resampling kept
+    cost |r, model| {
+        let p = r.params(model)?;
+        let opts = r.options();
         let tap_work = |q: &Params| -> Result<f64, SimError> {
             let lever_periods = (1.0 / q.omega).max(1.0);
             Ok((steady_periods(&opts.steady, q)? * q.modes as f64
                 + newton_work(q, 1, &opts.shooting))
                 * lever_periods)
         };
-        let points = match &self.sweep {
-            Some(s) => self.sweep_points(s, model, &p)?,
+        let points = match &r.sweep {
+            Some(s) => r.sweep_points(s, model, &p)?,
             None => vec![p],
         };
         let tap = points.iter().map(tap_work).sum::<Result<f64, SimError>>()?;
-        let per_value = if self.setpoint.is_some() {
+        let per_value = if r.setpoint.is_some() {
             (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
         } else {
             1.0
@@ -352,15 +337,13 @@ impl Request for PeakForceRequest {
         // the fit's resampled curve, 4 columns of 8 bytes twice
         Ok(Cost {
             bytes: MODEL_BYTES
-                + self.samples as f64 * 640.0
+                + r.samples as f64 * 640.0
                 + fit * 64.0
                 + 64.0 * state_bytes(&p)
                 + points.len() as f64 * record,
             // and the reported cycle's samples, each under a mode-period (1.3 µs measured)
-            work: taps * tap + self.samples as f64,
+            work: taps * tap + r.samples as f64,
         })
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        self.params(model)
-    }
+    };
+    computed_at |r, model| r.params(model)
 }

@@ -30,7 +30,6 @@
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::limits::Cost;
-use super::run::{Request, Resolved};
 use crate::analysis::reconstruct::{Method, ShiftCurve, NEAR_FIELD};
 use crate::analysis::reconstruct_am::AmCurve;
 use crate::analysis::reconstruct_exact::{check_exact, exact_weights, EXACT_MAX_ITERATIONS};
@@ -319,19 +318,16 @@ impl ReconstructRequest {
     }
 }
 
-impl Request for ReconstructRequest {
-    const COST_ADVICE: &'static str = "give fewer distances";
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        let curve = self.curve()?;
-        match self.inversion {
+impl_request! {
+    ReconstructRequest, "reconstruct", advice = "give fewer distances";
+    validate |r, _| {
+        let curve = r.curve()?;
+        match r.inversion {
             FmInversion::SaderJarvis => curve.method().map(|_| ()),
             FmInversion::Exact => check_exact(&curve),
         }
-    }
-    fn name(&self) -> &'static str {
-        "reconstruct"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+    };
+    cost |r, _| {
         // no integration; memory bounded by the method's own limit (ShiftCurve::method): the
         // FFT's three buffers of 16 bytes × the next power of two ≥ 2n, or the direct sum's
         // O(n) rows; the curve's columns (distance, shift, force, potential, law) and the
@@ -340,14 +336,14 @@ impl Request for ReconstructRequest {
         // the columns alone; the command line's resident set at 537 MB and 763 MB)
         // the work: the operations (OPERATION_WORK) of the FFTs' m log₂ m butterflies, m the
         // next power of two ≥ 2n, and the near field, or the direct sum's pairs
-        let n = self.frequency_shift.len();
-        let (curve, m) = (self.curve()?, (2 * n).next_power_of_two() as f64);
+        let n = r.frequency_shift.len();
+        let (curve, m) = (r.curve()?, (2 * n).next_power_of_two() as f64);
         let fft = m * m.log2();
         let (mut work_bytes, mut ops) = match curve.method()? {
             Method::Fft { .. } => (3.0 * 16.0 * m, 3.0 * fft + (NEAR_FIELD * n) as f64),
             Method::Direct => (8.0 * n as f64, (n * n) as f64 / 2.0),
         };
-        if self.inversion == FmInversion::Exact {
+        if r.inversion == FmInversion::Exact {
             // the forward relation's kernel and buffer (FFT of at most the next power of two
             // ≥ 2n) or its rows' weights, and the iterate's five columns; at every step
             let weights = exact_weights(&curve) as f64;
@@ -366,17 +362,13 @@ impl Request for ReconstructRequest {
 #[derive(Debug, Clone)]
 pub struct AmReconstruction(pub Value);
 
-impl Request for AmReconstruction {
-    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        am_curve_from_approach(&self.0).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "reconstruct"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        // no integration; the curve's and the inversion's columns (its weights are summed
-        // row by row, at most one a pair of points)
-        let n = am_curve_from_approach(&self.0)?.z_c.len() as f64;
+impl_request! {
+    AmReconstruction, "reconstruct";
+    validate |r, _| am_curve_from_approach(&r.0).map(|_| ());
+    // no integration; the curve's and the inversion's columns (its weights are summed row by
+    // row, at most one a pair of points)
+    cost |r, _| {
+        let n = am_curve_from_approach(&r.0)?.z_c.len() as f64;
         Ok(Cost {
             bytes: MODEL_BYTES + 12.0 * 8.0 * n,
             work: OPERATION_WORK * n * n,

@@ -391,51 +391,26 @@ impl ResonanceRequest {
 #[serde(transparent)]
 pub struct Bimodal(pub ApproachRequest);
 
-impl Request for ApproachRequest {
-    const COST_ADVICE: &'static str = CURVE_ADVICE;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "approach"
-    }
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Tapping
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        stepped_cost(&self.spec(model)?)
+impl_request! {
+    ApproachRequest, "approach", advice = CURVE_ADVICE, needs = Tapping;
+    validate |r, model| r.spec(model).map(|_| ());
+    cost |r, model| stepped_cost(&r.spec(model)?)
+}
+
+impl_request! {
+    ResonanceRequest, "resonance", advice = CURVE_ADVICE;
+    validate |r, model| r.spec(model).map(|_| ());
+    cost |r, model| stepped_cost(&r.spec(model)?);
+    computed_at |r, model| {
+        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), r.mode)
     }
 }
 
-impl Request for ResonanceRequest {
-    const COST_ADVICE: &'static str = CURVE_ADVICE;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "resonance"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        stepped_cost(&self.spec(model)?)
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
-    }
-}
-
-impl Request for Bimodal {
-    const COST_ADVICE: &'static str = CURVE_ADVICE;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+impl_request! {
+    Bimodal, "bimodal", advice = CURVE_ADVICE, needs = Tapping;
+    validate |r, model| {
         crate::request::curves::check_bimodal(&model.params)?;
-        self.0.validate(model)
-    }
-    fn name(&self) -> &'static str {
-        "bimodal"
-    }
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Tapping
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        self.0.cost(model)
-    }
+        r.0.validate(model)
+    };
+    cost |r, model| r.0.cost(model)
 }

@@ -13,7 +13,7 @@ use crate::analysis::observables::{observe_from, ObservableOptions};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
 use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
-use crate::error::SimError;
+use crate::error::{in_range, SimError};
 use crate::integrate::{build, IntegratorOptions};
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
@@ -272,13 +272,7 @@ pub(crate) const MAX_ADVANCE_PERIODS: usize = 1_000_000;
 /// [`SimError::OutOfRange`] for `periods` outside 1..=`MAX_ADVANCE_PERIODS`; the model's
 /// and the integrator's errors.
 pub fn advance_from_rest(params: &Params, periods: usize) -> Result<Vec<f64>, SimError> {
-    if !(1..=MAX_ADVANCE_PERIODS).contains(&periods) {
-        return Err(SimError::out_of_range(
-            "periods",
-            periods,
-            "must be in 1..=1000000",
-        ));
-    }
+    in_range("periods", periods, 1..=MAX_ADVANCE_PERIODS)?;
     let m = CantileverModel::new(params)?;
     let mut integ = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
     crate::integrate::advance(integ.as_mut(), periods as f64 * m.period())?;

@@ -514,20 +514,18 @@ pub(super) fn observe_window(
     weighting: Weighting,
 ) -> Result<Observables, SimError> {
     let taper = matches!(weighting, Weighting::Hann);
-    if !(1..=MAX_PERIODS).contains(&opts.periods) {
-        return Err(SimError::out_of_range(
-            "periods",
-            opts.periods,
-            "must be in 1..=1000000 (an integer number of drive periods)",
-        ));
-    }
-    if !(1..=MAX_HARMONICS).contains(&opts.harmonics) {
-        return Err(SimError::out_of_range(
-            "harmonics",
-            opts.harmonics,
-            "must be in 1..=10000 (the highest harmonic reported)",
-        ));
-    }
+    crate::error::within(
+        "periods",
+        opts.periods,
+        1..=MAX_PERIODS,
+        "must be in 1..=1000000 (an integer number of drive periods)",
+    )?;
+    crate::error::within(
+        "harmonics",
+        opts.harmonics,
+        1..=MAX_HARMONICS,
+        "must be in 1..=10000 (the highest harmonic reported)",
+    )?;
     let model = crate::tip_sample::require_cantilever(integ.system(), "the AFM observables")?;
     let mut ctx = Ctx::new(model, opts.harmonics);
     let p: Params = *ctx.model.params();

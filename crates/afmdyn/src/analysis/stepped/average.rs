@@ -24,7 +24,7 @@
 
 use super::{transient_cap, CurvePoint, Reached, SteppedSpec};
 use crate::analysis::observables::{observe_tapered, ObservableOptions, Observables};
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::integrate::build;
 use crate::model::CantileverModel;
 use crate::tip_sample::TipSampleSystem;
@@ -137,27 +137,24 @@ impl AverageOptions {
     /// # Errors
     /// [`SimError::OutOfRange`] naming the field.
     pub fn check(&self) -> Result<(), SimError> {
-        if !(1..=100_000).contains(&self.window_periods) {
-            return Err(SimError::out_of_range(
-                "average.window_periods",
-                self.window_periods,
-                "must be in 1..=100000 (drive periods per settling window)",
-            ));
-        }
-        if !(1..=1000).contains(&self.windows) {
-            return Err(SimError::out_of_range(
-                "average.windows",
-                self.windows,
-                "must be in 1..=1000 (settling windows in the measured window)",
-            ));
-        }
-        if !(1e-12..=1e-2).contains(&self.tol) {
-            return Err(SimError::out_of_range(
-                "average.tol",
-                self.tol,
-                "must be in [1e-12, 1e-2] (relative to each free amplitude)",
-            ));
-        }
+        within(
+            "average.window_periods",
+            self.window_periods,
+            1..=100_000,
+            "must be in 1..=100000 (drive periods per settling window)",
+        )?;
+        within(
+            "average.windows",
+            self.windows,
+            1..=1000,
+            "must be in 1..=1000 (settling windows in the measured window)",
+        )?;
+        within(
+            "average.tol",
+            self.tol,
+            1e-12..=1e-2,
+            "must be in [1e-12, 1e-2] (relative to each free amplitude)",
+        )?;
         Ok(())
     }
 }

@@ -44,7 +44,7 @@ use crate::analysis::shooting::{
     broyden_pays, shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,
 };
 use crate::analysis::steady::{decay_periods, SteadyOptions};
-use crate::error::SimError;
+use crate::error::{in_range, within, SimError};
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::{DiscreteMap, StroboscopicMap};
 use crate::model::CantileverModel;
@@ -110,9 +110,7 @@ pub(crate) fn grid(from: f64, to: f64, spacing: Spacing) -> Result<Vec<f64>, Sim
     }
     let points = match spacing {
         Spacing::Points(n) => {
-            if !(2..=MAX_CURVE_POINTS).contains(&n) {
-                return Err(SimError::out_of_range("points", n, "must be in 2..=100000"));
-            }
+            in_range("points", n, 2..=MAX_CURVE_POINTS)?;
             n
         }
         Spacing::Step(h) => {
@@ -505,13 +503,12 @@ pub(crate) fn sweep_points(
 /// # Errors
 /// [`SimError::OutOfRange`], [`SimError::NotFinite`], [`SimError::Params`].
 pub(crate) fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
-    if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
-        return Err(SimError::out_of_range(
-            "points",
-            spec.values.len(),
-            "a stepped sweep needs 2..=100000 values",
-        ));
-    }
+    within(
+        "points",
+        spec.values.len(),
+        2..=MAX_CURVE_POINTS,
+        "a stepped sweep needs 2..=100000 values",
+    )?;
     for &v in &spec.values {
         crate::error::finite("sweep value", v)?;
     }

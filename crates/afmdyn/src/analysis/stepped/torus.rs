@@ -28,7 +28,7 @@ use super::{relative_gap, CurvePoint, Reached, SteppedSpec};
 use crate::analysis::torus::{
     continue_circle, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
 };
-use crate::error::SimError;
+use crate::error::{within, SimError};
 use crate::maps::circle::MAX_NODES;
 use crate::model::CantileverModel;
 use crate::params::Params;
@@ -68,13 +68,12 @@ impl TorusOptions {
     /// # Errors
     /// [`SimError::OutOfRange`] naming `torus.nodes`.
     pub fn check(&self) -> Result<(), SimError> {
-        if !(1..=MAX_NODES).contains(&self.nodes) {
-            return Err(SimError::out_of_range(
-                "torus.nodes",
-                self.nodes,
-                "must be in 1..=1000 (nodes of the invariant circle)",
-            ));
-        }
+        within(
+            "torus.nodes",
+            self.nodes,
+            1..=MAX_NODES,
+            "must be in 1..=1000 (nodes of the invariant circle)",
+        )?;
         Ok(())
     }
 }
