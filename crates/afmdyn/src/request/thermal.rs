@@ -64,17 +64,38 @@ impl ThermalRequest {
 
     /// The warning of a temperature outside the typical range, naming the likely slip.
     pub fn warnings(&self) -> Vec<String> {
-        let t = self.temperature();
-        let (lo, hi) = TYPICAL_TEMPERATURE;
-        if (lo..=hi).contains(&t) {
-            return Vec::new();
-        }
-        vec![format!(
-            "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
-             in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
-            t + 273.15
-        )]
+        temperature_warnings(self.temperature())
     }
+}
+
+/// The warning of a temperature `t` (K) outside [`TYPICAL_TEMPERATURE`], naming the likely slip
+/// (`thermal`'s and `simulate`'s).
+pub fn temperature_warnings(t: f64) -> Vec<String> {
+    let (lo, hi) = TYPICAL_TEMPERATURE;
+    if (lo..=hi).contains(&t) {
+        return Vec::new();
+    }
+    vec![format!(
+        "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
+         in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
+        t + 273.15
+    )]
+}
+
+/// Check a temperature `t` (K) against [`TEMPERATURE_RANGE`] (`thermal`'s and `simulate`'s).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `temperature`.
+pub fn check_temperature(t: f64) -> Result<(), SimError> {
+    let (lo, hi) = TEMPERATURE_RANGE;
+    if t > lo && t <= hi {
+        return Ok(());
+    }
+    Err(bad(
+        "temperature",
+        crate::error::number(t),
+        "the temperature must be above absolute zero and at most 1500 K (K)",
+    ))
 }
 
 fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimError {
@@ -92,15 +113,7 @@ impl Request for ThermalRequest {
                 "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
             ));
         }
-        let t = self.temperature();
-        let (lo, hi) = TEMPERATURE_RANGE;
-        if !(t > lo && t <= hi) {
-            return Err(bad(
-                "temperature",
-                crate::error::number(t),
-                "the temperature must be above absolute zero and at most 1500 K (K)",
-            ));
-        }
+        check_temperature(self.temperature())?;
         let spot = self.spot();
         if !(spot > 0.0 && spot <= 1.0) {
             return Err(bad(

@@ -291,3 +291,50 @@ fn the_bridge_finds_the_crossings_a_coarse_grid_misses() {
     assert!((f_coarse - f_fine).abs() < 5.0 * sigma);
     assert!(s_coarse > grid_changes);
 }
+
+/// `simulate`'s `temperature`: refused without a probe (naming `temperature`) and for a
+/// nonlinear law (naming the law); with the linear probe the same seed records the same run
+/// and another seed another one; no temperature is the deterministic integrator.
+#[test]
+fn simulate_takes_a_temperature_with_a_probe() {
+    use crate::request::simulate::SimulateRequest;
+    let p = water_linear(8e-9, 10e-9);
+    let model = CantileverModel::new(&p.params).unwrap();
+    let request = |t: Option<f64>, seed: u64| SimulateRequest {
+        periods: Some(5.0),
+        temperature: t,
+        seed,
+        samples_per_period: 50,
+        ..SimulateRequest::default()
+    };
+    let span = request(Some(295.0), 0)
+        .validate_in_memory(&p.params)
+        .unwrap();
+    match request(Some(295.0), 0).record_whole(&model, None, &span) {
+        Err(SimError::OutOfRange { name, .. }) => assert_eq!(name, "temperature"),
+        other => panic!("{other:?}"),
+    }
+    let dmt = Probe::parse(
+        include_str!("../../../../../../examples/probe-water-beam.toml"),
+        "w",
+    )
+    .unwrap();
+    let dmt_model = CantileverModel::new(&dmt.params).unwrap();
+    match request(Some(295.0), 0).record_whole(&dmt_model, Some(&dmt), &span) {
+        Err(SimError::Unsupported { law, .. }) => assert_eq!(law, "dmt"),
+        other => panic!("{other:?}"),
+    }
+    let run = |seed| {
+        let (tr, name) = (request(Some(295.0), seed))
+            .record_whole(&model, Some(&p), &span)
+            .unwrap();
+        assert_eq!(name, "exact-thermal");
+        tr.samples.iter().map(|s| s.v_t).collect::<Vec<f64>>()
+    };
+    assert_eq!(run(1), run(1));
+    assert_ne!(run(1), run(2));
+    let (_, name) = request(None, 0)
+        .record_whole(&model, Some(&p), &span)
+        .unwrap();
+    assert_eq!(name, "exact");
+}
