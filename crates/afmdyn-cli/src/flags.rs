@@ -176,6 +176,12 @@ pub struct SimulateFlags {
     /// `--energy-balance`: the request's `energy_balance`.
     #[arg(long, help = "Audit the energy balance of every drive period (energy.csv, the series' energy_* variables and the summary's energy_residual, whose residual checks the integration); off by default, as it takes a quarter to a half of the run's time (docs/performance/recording.md).")]
     pub energy_balance: bool,
+    /// `--seed`: the request's `seed`.
+    #[arg(long, default_value = "0", help = "The seed of the thermal force's random stream (with --temperature; default 0): a run is a function of its seed, whatever the threads.")]
+    pub seed: u64,
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise, the deterministic run. Each mode's equation then carries the white force the fluctuation–dissipation theorem gives for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by the exact stochastic step of the linear law (crate::integrate::exact::noise). Needs the probe's SI units (--probe) and the linear law; not with --energy-balance.")]
+    pub temperature: Option<f64>,
     /// The flags of the nested `integrator`.
     #[command(flatten)]
     pub integrator: IntegratorFlags,
@@ -190,7 +196,9 @@ impl SimulateFlags {
             integrator: self.integrator.request(),
             periods: self.periods,
             samples_per_period: self.samples_per_period,
+            seed: self.seed,
             tau_end: self.tau_end,
+            temperature: self.temperature,
             transient: self.transient,
         }
     }

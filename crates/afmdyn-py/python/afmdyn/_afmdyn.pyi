@@ -221,8 +221,10 @@ SimulateRequest = TypedDict(
         "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "periods": Optional[float],  # default null
         "samples_per_period": int,  # default 200
+        "seed": int,  # default 0
         "steps_per_period": Optional[int],  # default null
         "tau_end": Optional[float],  # default null
+        "temperature": Optional[float],  # default null
         "tolerance": float,  # default 1e-12
         "transient": float,  # default 0.0
     },

@@ -67,8 +67,10 @@ def simulate(
     integrator: Optional[str] = None,
     periods: Optional[float] = None,
     samples_per_period: int = 200,
+    seed: int = 0,
     steps_per_period: Optional[int] = None,
     tau_end: Optional[float] = None,
+    temperature: Optional[float] = None,
     tolerance: float = 1e-12,
     transient: float = 0.0,
     progress: ProgressArg = None,
@@ -92,9 +94,18 @@ def simulate(
         periods: Drive periods recorded after the transient (> 0); default 50 when
             ``tau_end`` is not given either.
         samples_per_period: Samples per drive period, 1..=100000.
+        seed: The seed of the thermal force's random stream (with ``temperature``; default
+            0): a run is a function of its seed, whatever the threads.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
         tau_end: End time τ of the run, instead of ``periods``.
+        temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
+            200–500 K it warns, a value in °C?); ``None`` (the default): no thermal noise,
+            the deterministic run. Each mode's equation then carries the white force the
+            fluctuation–dissipation theorem gives for its damping (the lever's, the
+            medium's, in contact the sample's dashpot), advanced by the exact stochastic
+            step of the linear law (``crate::integrate::exact::noise``). Needs the probe's
+            SI units (``--probe``) and the linear law; not with ``energy_balance``.
         tolerance: Relative and absolute tolerance of the adaptive integrator.
         transient: Drive periods discarded before recording, >= 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a

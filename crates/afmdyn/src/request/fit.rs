@@ -454,15 +454,8 @@ impl FitRequest {
                 )),
             };
         };
-        let (lo, hi) = super::thermal::TEMPERATURE_RANGE;
+        super::thermal::check_temperature(t)?;
         let number = crate::error::number;
-        if !(t > lo && t <= hi) {
-            return Err(bad(
-                "temperature",
-                number(t),
-                "above 0 K and at most 1500 K".into(),
-            ));
-        }
         if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
             return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)".into()));
         }

@@ -3,9 +3,14 @@
 
 use super::analyses::{check_samples_per_period, IntegratorRequest};
 use super::limits::*;
+use crate::analysis::thermal::ModelUnits;
 use crate::error::SimError;
-use crate::integrate::IntegratorOptions;
+use crate::integrate::exact::{ThermalExact, ThermalForce};
+use crate::integrate::{Integrator, IntegratorKind, IntegratorOptions};
+use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::probe::Probe;
+use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
 /// Where a recorded time series goes, which sets its budget.
@@ -45,6 +50,17 @@ pub struct SimulateRequest {
     /// (`docs/performance/recording.md`).
     #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
     pub energy_balance: bool,
+    /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
+    /// a value in °C?); `None` (the default): no thermal noise, the deterministic run. Each
+    /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
+    /// for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by
+    /// the exact stochastic step of the linear law (`crate::integrate::exact::noise`). Needs
+    /// the probe's SI units (`--probe`) and the linear law; not with `energy_balance`.
+    pub temperature: Option<f64>,
+    /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
+    /// a function of its seed, whatever the threads.
+    #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
+    pub seed: u64,
     /// The integrator.
     #[serde(flatten)]
     pub integrator: IntegratorRequest,
@@ -59,6 +75,8 @@ impl Default for SimulateRequest {
             initial: None,
             samples_per_period: 200,
             energy_balance: false,
+            temperature: None,
+            seed: 0,
             integrator: IntegratorRequest::default(),
         }
     }
@@ -171,6 +189,87 @@ impl SimulateRequest {
             total_periods,
             rows,
         })
+    }
+}
+
+impl SimulateRequest {
+    /// The thermal force of the run: `None` without a temperature; with one, its range checked
+    /// ([`super::thermal::check_temperature`]) and k_B T in the units of `probe`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `temperature` (out of range, or without a probe: the
+    /// dimensionless model has no k_B T) or `energy_balance` (the audit assumes no random
+    /// force).
+    pub fn thermal(&self, probe: Option<&Probe>) -> Result<Option<ThermalForce>, SimError> {
+        let Some(t) = self.temperature else {
+            return Ok(None);
+        };
+        super::thermal::check_temperature(t)?;
+        let Some(probe) = probe else {
+            return Err(SimError::out_of_range(
+                "temperature",
+                crate::error::number(t),
+                "thermal noise needs the probe's SI units (k_B T in the model's energy unit): \
+                 give the probe (--probe), or drop temperature",
+            ));
+        };
+        if self.energy_balance {
+            return Err(SimError::out_of_range(
+                "energy_balance",
+                "true with temperature",
+                "the energy audit's balance has no random force: drop energy_balance or \
+                 temperature",
+            ));
+        }
+        let units = ModelUnits::from(&probe.scales);
+        Ok(Some(ThermalForce::new(t, units, self.seed)))
+    }
+
+    /// The warnings of the request: a temperature outside the laboratory's range.
+    pub fn warnings(&self) -> Vec<String> {
+        (self.temperature.map(super::thermal::temperature_warnings)).unwrap_or_default()
+    }
+
+    /// The integrator of the run of `model` from `z0` at τ = 0: [`crate::integrate::build`]'s,
+    /// or with a temperature the exact stochastic step ([`ThermalExact`]) on a grid that is a
+    /// multiple of the samples per period (the samples are its points).
+    ///
+    /// # Errors
+    /// As [`SimulateRequest::thermal`], [`crate::integrate::build`] and [`ThermalExact::new`];
+    /// [`SimError::OutOfRange`] naming `integrator` for a temperature with an integrator other
+    /// than `auto` or `exact`.
+    pub fn integrator(
+        &self,
+        model: &CantileverModel,
+        probe: Option<&Probe>,
+        z0: &DVector<f64>,
+    ) -> Result<Box<dyn Integrator>, SimError> {
+        let mut opts = self.integrator_options()?;
+        let Some(force) = self.thermal(probe)? else {
+            return crate::integrate::build(model, opts, 0.0, z0);
+        };
+        if !matches!(opts.kind, IntegratorKind::Auto | IntegratorKind::Exact) {
+            return Err(SimError::out_of_range(
+                "integrator",
+                format!("{:?} with temperature", opts.kind).to_lowercase(),
+                "thermal noise is advanced by the exact stochastic step: auto or exact",
+            ));
+        }
+        // the least common multiple of the steps and the samples per period
+        let (a, s) = (opts.steps_per_period.max(1), self.samples_per_period.max(1));
+        opts.steps_per_period = a / gcd(a, s) * s;
+        let mut it = ThermalExact::new(model, &opts, force)?;
+        it.reset(0.0, z0)?;
+        Ok(Box::new(it))
+    }
+}
+
+/// The greatest common divisor (Euclid).
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
     }
 }
 

@@ -63,6 +63,7 @@ impl Request for SimulateStream {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.span(&model.params)?;
         self.request.integrator_options()?;
+        self.request.thermal(model.probe.as_ref())?;
         let m = CantileverModel::new(&model.params)?;
         initial_state(&m, self.request.initial.as_deref()).map(|_| ())
     }

@@ -68,8 +68,9 @@ impl ThermalRequest {
     }
 }
 
-/// The warning of a temperature `t` (K) outside the typical range, naming the likely slip.
-pub(crate) fn temperature_warnings(t: f64) -> Vec<String> {
+/// The warning of a temperature `t` (K) outside [`TYPICAL_TEMPERATURE`], naming the likely slip
+/// (`thermal`'s, `calibrate`'s and `simulate`'s).
+pub fn temperature_warnings(t: f64) -> Vec<String> {
     let (lo, hi) = TYPICAL_TEMPERATURE;
     if (lo..=hi).contains(&t) {
         return Vec::new();
@@ -82,6 +83,23 @@ pub(crate) fn temperature_warnings(t: f64) -> Vec<String> {
          in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
         t + 273.15
     )]
+}
+
+/// Check a temperature `t` (K) against [`TEMPERATURE_RANGE`] (`thermal`'s, `calibrate`'s,
+/// `fit`'s and `simulate`'s).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `temperature`.
+pub fn check_temperature(t: f64) -> Result<(), SimError> {
+    let (lo, hi) = TEMPERATURE_RANGE;
+    if t > lo && t <= hi {
+        return Ok(());
+    }
+    Err(bad(
+        "temperature",
+        crate::error::number(t),
+        "the temperature must be above absolute zero and at most 1500 K (K)",
+    ))
 }
 
 /// The checks of a temperature `t` (K) and a laser spot `spot` shared by the thermal
@@ -98,14 +116,7 @@ pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), S
             "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
         ));
     }
-    let (lo, hi) = TEMPERATURE_RANGE;
-    if !(t > lo && t <= hi) {
-        return Err(bad(
-            "temperature",
-            crate::error::number(t),
-            "the temperature must be above absolute zero and at most 1500 K (K)",
-        ));
-    }
+    check_temperature(t)?;
     if !(spot > 0.0 && spot <= 1.0) {
         return Err(bad(
             "spot",

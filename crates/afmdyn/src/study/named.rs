@@ -79,13 +79,14 @@ fn simulate(request: &SimulateRequest, model: &Resolved) -> Result<Outcome, SimE
     let span = request.validate_in_memory(p)?;
     let su = report::SeriesUnits::new(p, model.probe.as_ref());
     let m = CantileverModel::new(p)?;
-    let (tr, integrator) = request.record_whole(&m, &span)?;
+    let (tr, integrator) = request.record_whole(&m, model.probe.as_ref(), &span)?;
     let layout = report::simulate_layout(&m, &tr, &su, request.samples_per_period);
     let mut document = report::with_si(
         report::simulate(&m, &tr, request.energy_balance),
         model.probe.as_ref(),
         p,
     );
+    request.thermal_into(&mut document);
     // a trajectory from its start, as the streamed run's (`SimulateStream`)
     report::Convergence::exact("trajectory").write_into(&mut document);
     let facts = serde_json::json!({

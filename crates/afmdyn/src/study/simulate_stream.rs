@@ -10,7 +10,6 @@ use crate::analysis::progress::Progress;
 use crate::analysis::spectrum::amplitude_spectrum;
 use crate::analysis::spectrum::SPECTRUM_SAMPLES;
 use crate::error::SimError;
-use crate::integrate::build;
 use crate::layout::figure::PixelColumns;
 use crate::layout::figure::{Figure, Plot, Series, Style};
 use crate::layout::files::f;
@@ -57,7 +56,7 @@ impl Analysis for SimulateStream {
         let span = self.span(p)?;
         let m = CantileverModel::new(p)?;
         let z0 = initial_state(&m, self.request.initial.as_deref())?;
-        let mut integ = build(&m, self.request.integrator_options()?, 0.0, &z0)?;
+        let mut integ = self.request.integrator(&m, model.probe.as_ref(), &z0)?;
         let su = SeriesUnits::new(p, model.probe.as_ref());
         let mut files = match &self.dir {
             Some(dir) => {
@@ -128,6 +127,7 @@ impl Analysis for SimulateStream {
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         let mut doc = report::simulate_summary(&CantileverModel::new(&model.params)?, &r.summary);
         doc["files"] = json!(self.files());
+        self.request.thermal_into(&mut doc);
         Ok(doc)
     }
     fn present(

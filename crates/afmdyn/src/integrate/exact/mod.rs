@@ -41,7 +41,8 @@
 //! `step.rs` (one step and the switching test; the search in `search.rs`), `run.rs` (runs of
 //! certified whole grid steps), `series.rs` (the last step, dense output, tip series), `span.rs` (spans of steps),
 //! `sensitivity.rs` (step Jacobians and ∂z/∂p), `bound.rs` (the displacement bound),
-//! `integrator.rs` (the [`Integrator`] implementation), `spectral.rs` and `modal.rs` (the
+//! `integrator.rs` (the [`Integrator`] implementation), `noise.rs` (the thermally driven lever's
+//! exact stochastic step, [`ThermalExact`]), `spectral.rs` and `modal.rs` (the
 //! spectral data of the region matrices, the eigendecomposition), `tip.rs` (V_T of a plain
 //! state), `tests.rs`.
 //!
@@ -58,6 +59,7 @@ mod forcing;
 mod handoff;
 mod integrator;
 mod modal;
+pub mod noise;
 mod run;
 mod sample;
 mod search;
@@ -74,6 +76,7 @@ mod tip;
 pub(crate) use crate::linalg::matmul_into;
 pub use build::{ExactOptions, Propagation};
 pub use cache::PropagatorCache;
+pub use noise::{ThermalExact, ThermalForce};
 
 use super::grid::PeriodGrid;
 use super::ChatterWindow;

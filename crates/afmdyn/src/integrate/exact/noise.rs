@@ -1,0 +1,584 @@
+//! The thermally driven lever: the exact stochastic step of the piecewise-linear model
+//! ([`ThermalExact`]), with the switchings the noise makes between two steps located on the
+//! path's Gaussian bridge.
+//!
+//! # The stochastic system
+//! In each region s the state z = (a, ȧ) obeys dz = (A_s z + f(τ)) dτ + G dW, the thermal force
+//! ξ on the modal coordinates white with ⟨ξ(τ)ξ(τ')ᵀ⟩ = 2 k_B T C_s δ(τ − τ') by the
+//! fluctuation–dissipation theorem (C_s the region's modal damping: the lever's, the medium's
+//! per mode and, in contact, the sample's dashpot; Callen & Welton, *Phys. Rev.* 83 (1951) 34),
+//! so GGᵀ = [[0, 0], [0, M⁻¹ 2k_BT C_s M⁻¹]]. k_B T is in the model's energy unit, force × length
+//! ([`ThermalForce::new`]), so that the stationary covariance is P = diag(k_BT K⁻¹, k_BT M⁻¹)
+//! (A P + P Aᵀ + GGᵀ = 0), the equipartition `crate::analysis::thermal` reports.
+//!
+//! # The exact step
+//! With δz = z − z_p(τ) (z_p the region's periodic particular solution, as the deterministic
+//! propagator's, [`super::ExactPropagator`]) the step of length ℓ is
+//! δz(τ + ℓ) = Φ(ℓ) δz(τ) + w, w ~ N(0, Q(ℓ)), Φ(ℓ) = e^{A_s ℓ}, Q(ℓ) = ∫₀^ℓ e^{A_s u} GGᵀ
+//! e^{A_sᵀ u} du, exact at any ℓ (the free lever's thermal motion is exact whatever the grid).
+//! Φ and Q come from one block exponential, exp([[−A, GGᵀ], [0, Aᵀ]] ℓ) = [[·, F₁₂], [0, F₂₂]]:
+//! Φ = F₂₂ᵀ, Q = F₂₂ᵀ F₁₂ (C. F. Van Loan, "Computing integrals involving the matrix
+//! exponential", *IEEE Trans. Autom. Control* 23 (1978) 395–404, Theorem 1). w is drawn as S ζ,
+//! S = V Λ^{1/2} (Q = V Λ Vᵀ; Q is semi-definite), ζ standard normal by the Box–Muller
+//! transform (G. E. P. Box and M. E. Muller, *Ann. Math. Stat.* 29 (1958) 610) of a ChaCha8
+//! stream seeded by the seed alone: a run is a function of its seed, whatever the threads.
+//!
+//! # Switchings between two steps: the bridge
+//! Given δz at the ends a, b of an interval of length ℓ the path inside is a Gaussian bridge;
+//! at the midpoint it is normal with mean Φ(ℓ/2) δz_a + B (δz_b − Φ(ℓ) δz_a) and covariance
+//! Q(ℓ/2) − B Φ(ℓ/2) Q(ℓ/2), B = Q(ℓ/2) Φ(ℓ/2)ᵀ Q(ℓ)⁺ (the conditional of a Gaussian vector).
+//! The grid step h is the top of a dyadic ladder ℓ_k = h/2^k, k = 0..=[`LEVELS`], whose Φ, Q
+//! and bridge gains are tabulated per region. An interval is refined — its midpoint drawn from
+//! the bridge, the left half searched first — when the gap g = ±V_T at its right end is ≤ 0 or
+//! the gap of the bridge's mean at its midpoint is within [`KAPPA`] standard deviations of the
+//! surface (g's bridge standard deviation is fixed per level); at level [`LEVELS`] the first
+//! point with g ≤ 0 is the switching. **Error**: the switching time is located to within
+//! h/2^LEVELS (h/4096) and the state there is the path's (its gap past the surface by at most
+//! |ġ| h/4096); an excursion across the surface is missed only where every tested midpoint of
+//! its interval is κ = 6 standard deviations clear of the surface by the bridge (a probability
+//! below 10⁻⁹ per test for the noise) and the deterministic part dips across between points
+//! h/4096 apart while its mean at their midpoint stays clear (a dip shallower than
+//! |g''| (h/8192)²/2). After a switching the rest of the grid step is taken in the new region
+//! by the dyadic pieces of the ladder, each searched the same way, so the path stays on the
+//! ladder; a piece to a time off it (the run's end) has its own ladder, built on demand.
+//!
+//! The path between recorded points (dense output) is drawn from the bridge between the nearest
+//! points already drawn, by a second stream of the seed, so that the path at the grid points
+//! does not depend on the samples asked for.
+
+use super::forcing::Forced;
+use super::tip::tip_v_t;
+use super::{ExactOptions, ExactPropagator};
+use crate::analysis::thermal::{ModelUnits, BOLTZMANN};
+use crate::error::SimError;
+use crate::integrate::{Integrator, IntegratorOptions, Step};
+use crate::model::CantileverModel;
+use crate::system::Region;
+use crate::tip_sample::TipSampleSystem;
+use nalgebra::{DMatrix, DVector};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::sync::Arc;
+
+/// The levels of the dyadic ladder below a grid step: a switching is located to h/2^LEVELS.
+pub const LEVELS: usize = 12;
+/// An interval is refined where its bridge's mean gap at the midpoint is within KAPPA standard
+/// deviations of the surface.
+pub const KAPPA: f64 = 6.0;
+/// The second stream's seed offset (dense output between the drawn points).
+const DENSE_STREAM: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// The thermal force of a run: k_B T in the model's energy unit and the seed of its stream.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalForce {
+    /// k_B T / (force × length unit): the model's k_B T.
+    pub kt: f64,
+    /// The seed of the random stream.
+    pub seed: u64,
+}
+
+impl ThermalForce {
+    /// The force at `temperature` (K) of a model in `units`: k_B T/(F₀ L₀) with F₀, L₀ the
+    /// newtons and metres per unit force and length (the energy unit of `units`, the one of
+    /// `crate::analysis::thermal`'s equipartition).
+    pub fn new(temperature: f64, units: ModelUnits, seed: u64) -> ThermalForce {
+        ThermalForce {
+            kt: BOLTZMANN * temperature / (units.force_n * units.length_m),
+            seed,
+        }
+    }
+}
+
+/// The diffusion GGᵀ = [[0, 0], [0, M⁻¹ 2k_BT C_s M⁻¹]] of region `r` of `model` (2N × 2N).
+pub(crate) fn diffusion(model: &CantileverModel, r: Region, kt: f64) -> DMatrix<f64> {
+    let g = model.galerkin();
+    let n = model.modes();
+    let minv = (g.region(Region::Free).mass.clone().try_inverse()).unwrap_or(DMatrix::zeros(n, n));
+    let c = &g.region(r).damping;
+    let mut d = DMatrix::zeros(2 * n, 2 * n);
+    let block = &minv * c * minv.transpose() * (2.0 * kt);
+    d.view_mut((n, n), (n, n))
+        .copy_from(&(0.5 * (&block + block.transpose())));
+    d
+}
+
+/// Φ(ℓ) = e^{Aℓ} and Q(ℓ) = ∫₀^ℓ e^{Au} D e^{Aᵀu} du by Van Loan's block exponential (module
+/// docs).
+pub(crate) fn van_loan(a: &DMatrix<f64>, d: &DMatrix<f64>, l: f64) -> (DMatrix<f64>, DMatrix<f64>) {
+    let n = a.nrows();
+    let mut big = DMatrix::zeros(2 * n, 2 * n);
+    big.view_mut((0, 0), (n, n)).copy_from(&(-a * l));
+    big.view_mut((0, n), (n, n)).copy_from(&(d * l));
+    big.view_mut((n, n), (n, n)).copy_from(&(a.transpose() * l));
+    let e = big.exp();
+    let phi = e.view((n, n), (n, n)).transpose();
+    let q = &phi * e.view((0, n), (n, n));
+    let q = 0.5 * (&q + q.transpose());
+    (phi, q)
+}
+
+/// A square root S (S Sᵀ = Q) of a symmetric semi-definite Q: V Λ^{1/2}, negative round-off
+/// eigenvalues clamped to zero.
+fn root(q: &DMatrix<f64>) -> DMatrix<f64> {
+    let e = q.clone().symmetric_eigen();
+    let mut s = e.eigenvectors;
+    for (j, l) in e.eigenvalues.iter().enumerate() {
+        s.column_mut(j).scale_mut(l.max(0.0).sqrt());
+    }
+    s
+}
+
+/// The pseudo-inverse of a symmetric semi-definite Q (eigenvalues below 10⁻¹³ of the largest
+/// dropped: the directions the noise does not reach).
+fn pinv(q: &DMatrix<f64>) -> DMatrix<f64> {
+    let e = q.clone().symmetric_eigen();
+    let top = e.eigenvalues.iter().fold(0.0_f64, |m, l| m.max(l.abs()));
+    let mut v = e.eigenvectors.clone();
+    for (j, &l) in e.eigenvalues.iter().enumerate() {
+        v.column_mut(j)
+            .scale_mut(if l > 1e-13 * top { 1.0 / l } else { 0.0 });
+    }
+    v * e.eigenvectors.transpose()
+}
+
+/// The bridge to a point inside an interval: δz = Φ₁ δz_a + B (δz_b − Φ δz_a) + S ζ.
+#[derive(Debug, Clone)]
+struct Bridge {
+    phi1: DMatrix<f64>,
+    gain: DMatrix<f64>,
+    phi: DMatrix<f64>,
+    root: DMatrix<f64>,
+    /// The standard deviation of the tip's deflection at the point.
+    tip_sd: f64,
+}
+
+impl Bridge {
+    /// The bridge at u₁ after a of an interval of u₁ + u₂ in region (`a`, `d`), the tip vector
+    /// `tip` (shape `[N]`).
+    fn new(a: &DMatrix<f64>, d: &DMatrix<f64>, u1: f64, u2: f64, tip: &DVector<f64>) -> Bridge {
+        let (phi1, q1) = van_loan(a, d, u1);
+        let (phi2, _) = van_loan(a, d, u2);
+        let (phi, q) = van_loan(a, d, u1 + u2);
+        Self::from_parts(phi1, q1, &phi2, phi, &q, tip)
+    }
+
+    fn from_parts(
+        phi1: DMatrix<f64>,
+        q1: DMatrix<f64>,
+        phi2: &DMatrix<f64>,
+        phi: DMatrix<f64>,
+        q: &DMatrix<f64>,
+        tip: &DVector<f64>,
+    ) -> Bridge {
+        let gain = &q1 * phi2.transpose() * pinv(q);
+        let cov = &q1 - &gain * phi2 * &q1;
+        let root = root(&(0.5 * (&cov + cov.transpose())));
+        let n = tip.len();
+        let tip_sd = (root.rows(0, n).transpose() * tip).norm();
+        Bridge {
+            phi1,
+            gain,
+            phi,
+            root,
+            tip_sd,
+        }
+    }
+
+    /// The bridge's mean at the point given δz at the ends.
+    fn mean(&self, da: &DVector<f64>, db: &DVector<f64>) -> DVector<f64> {
+        &self.phi1 * da + &self.gain * (db - &self.phi * da)
+    }
+}
+
+/// One rung of a ladder: the step of length ℓ_k (Φ and Q's root) and the bridge to its middle.
+#[derive(Debug, Clone)]
+struct Rung {
+    phi: DMatrix<f64>,
+    root: DMatrix<f64>,
+    mid: Bridge,
+}
+
+/// The ladder of region (`a`, `d`) from a step of `len`: rungs k = 0..=LEVELS of ℓ_k = len/2^k.
+fn ladder(a: &DMatrix<f64>, d: &DMatrix<f64>, len: f64, tip: &DVector<f64>) -> Arc<[Rung]> {
+    let steps: Vec<(DMatrix<f64>, DMatrix<f64>)> = (0..=LEVELS + 1)
+        .map(|k| van_loan(a, d, len / (1u64 << k) as f64))
+        .collect();
+    (0..=LEVELS)
+        .map(|k| {
+            let (phi, q) = &steps[k];
+            let (phi_half, q_half) = &steps[k + 1];
+            let mid = Bridge::from_parts(
+                phi_half.clone(),
+                q_half.clone(),
+                phi_half,
+                phi.clone(),
+                q,
+                tip,
+            );
+            Rung {
+                phi: phi.clone(),
+                root: root(q),
+                mid,
+            }
+        })
+        .collect()
+}
+
+/// A point of the path: τ, its position on the ladder (`None` off it) and z.
+type Point = (f64, DVector<f64>);
+
+/// The exact stochastic step of the piecewise-linear model (module docs), an [`Integrator`]
+/// whose state carries the thermal force.
+#[derive(Debug, Clone)]
+pub struct ThermalExact {
+    /// The deterministic propagator: the model, the grid and the particular solutions.
+    det: ExactPropagator,
+    /// The model (the propagator's, for [`Integrator::system`]).
+    model: CantileverModel,
+    force: ThermalForce,
+    /// GGᵀ of both regions.
+    diffusion: [DMatrix<f64>; 2],
+    /// The ladders of the grid step of both regions.
+    ladders: [Arc<[Rung]>; 2],
+    /// The last ladder built for a piece off the grid: its region, length and rungs.
+    odd: Option<(Region, f64, Arc<[Rung]>)>,
+    rng: ChaCha8Rng,
+    dense_rng: ChaCha8Rng,
+    /// The second normal of the last Box–Muller pair of each stream.
+    spare: [Option<f64>; 2],
+    tau: f64,
+    z: DVector<f64>,
+    region: Region,
+    /// The position on the ladder: grid step j and the offset i in units of h/2^LEVELS
+    /// (`None` off it).
+    at: Option<(i64, u64)>,
+    /// The points drawn in the last step, in τ order, and its region.
+    points: Vec<Point>,
+    last_region: Region,
+}
+
+/// Where a piece ends: its length, its rung (0 a grid step), its ladder position at the end.
+type Piece = (f64, usize, Option<(i64, u64)>, Option<Arc<[Rung]>>);
+
+impl ThermalExact {
+    /// Build for `model` with `force`, the grid of the exact propagator for `opts` (a multiple
+    /// of its steps per period, refined to resolve the fastest mode).
+    ///
+    /// # Errors
+    /// [`SimError::Unsupported`] naming the law for a law that is not piecewise linear (the
+    /// nonlinear laws' stochastic integration is not built); the exact propagator's.
+    pub fn new(
+        model: &CantileverModel,
+        opts: &IntegratorOptions,
+        force: ThermalForce,
+    ) -> Result<ThermalExact, SimError> {
+        if !model.law().is_affine() {
+            return Err(SimError::Unsupported {
+                integrator: "exact-thermal",
+                law: model.law().name(),
+                hint: "thermal noise (temperature) is simulated for the linear law only, by the \
+                       exact stochastic step; drop temperature for this law",
+            });
+        }
+        let det = ExactPropagator::try_with(
+            model,
+            ExactOptions {
+                min_steps_per_period: opts.steps_per_period,
+                cache: Some(opts.cache.clone()),
+                ..ExactOptions::default()
+            },
+        )?;
+        let diffusion = [Region::Free, Region::Contact].map(|r| diffusion(model, r, force.kt));
+        let h = det.grid.h;
+        let ladders = [Region::Free, Region::Contact]
+            .map(|r| ladder(&model.dynamics(r).a, &diffusion[r.index()], h, model.tip()));
+        let n = 2 * model.modes();
+        Ok(ThermalExact {
+            det,
+            model: model.clone(),
+            force,
+            diffusion,
+            ladders,
+            odd: None,
+            rng: ChaCha8Rng::seed_from_u64(force.seed),
+            dense_rng: ChaCha8Rng::seed_from_u64(force.seed ^ DENSE_STREAM),
+            spare: [None, None],
+            tau: 0.0,
+            z: DVector::zeros(n),
+            region: Region::Free,
+            at: Some((0, 0)),
+            points: Vec::new(),
+            last_region: Region::Free,
+        })
+    }
+
+    /// The thermal force.
+    pub fn force(&self) -> ThermalForce {
+        self.force
+    }
+
+    /// The grid's sub-steps per drive period.
+    pub fn steps_per_period(&self) -> usize {
+        self.det.grid.m
+    }
+
+    fn model(&self) -> &CantileverModel {
+        &self.model
+    }
+
+    /// A standard normal from stream `s` (0 the path's, 1 the dense output's), Box–Muller.
+    fn normal(&mut self, s: usize) -> f64 {
+        if let Some(x) = self.spare[s].take() {
+            return x;
+        }
+        let rng = if s == 0 {
+            &mut self.rng
+        } else {
+            &mut self.dense_rng
+        };
+        // u₁ in (0, 1]: ln u₁ finite
+        let u1 = 1.0 - rng.random::<f64>();
+        let u2: f64 = rng.random();
+        let r = (-2.0 * u1.ln()).sqrt();
+        let (s2, c2) = (std::f64::consts::TAU * u2).sin_cos();
+        self.spare[s] = Some(r * s2);
+        r * c2
+    }
+
+    /// S ζ for a root S (2N × 2N) from stream `s`.
+    fn draw(&mut self, root: &DMatrix<f64>, s: usize) -> DVector<f64> {
+        let zeta = DVector::from_fn(root.ncols(), |_, _| self.normal(s));
+        root * zeta
+    }
+
+    /// z_p(τ) of region `r`.
+    fn zp(&self, r: Region, tau: f64) -> DVector<f64> {
+        let f: &Forced = &self.det.forced[r.index()];
+        let (s, c) = (self.model().omega() * tau).sin_cos();
+        &f.p0 + &f.ps * s + &f.pc * c
+    }
+
+    /// The gap ±V_T (+ free, − in contact) of z at τ in region `r`.
+    fn gap(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
+        let sc = (self.model().omega() * tau).sin_cos();
+        let v = tip_v_t(self.model(), z.as_slice(), sc).0;
+        if r == Region::Free {
+            v
+        } else {
+            -v
+        }
+    }
+
+    /// τ of ladder position (j, i).
+    fn lattice_tau(&self, (j, i): (i64, u64)) -> f64 {
+        self.det.grid.tau(j) + i as f64 * self.det.grid.h / (1u64 << LEVELS) as f64
+    }
+
+    /// The next piece from the current state towards `tau_max`.
+    fn next_piece(&mut self, tau_max: f64) -> Piece {
+        let top = 1u64 << LEVELS;
+        if let Some((j, i)) = self.at {
+            let k = if i == 0 {
+                0
+            } else {
+                LEVELS - i.trailing_zeros() as usize
+            };
+            let i1 = i + (top >> k);
+            let end = if i1 == top { (j + 1, 0) } else { (j, i1) };
+            let len = self.det.grid.h / (1u64 << k) as f64;
+            if self.lattice_tau(end) <= tau_max {
+                return (len, k, Some(end), None);
+            }
+        }
+        // off the ladder, or past tau_max: a piece with its own ladder to the next grid point
+        // or to tau_max
+        let jn = self.det.grid.next_index(self.tau);
+        let t_grid = self.det.grid.tau(jn);
+        let (t1, at) = if t_grid <= tau_max {
+            (t_grid, Some((jn, 0)))
+        } else {
+            (tau_max, None)
+        };
+        let len = t1 - self.tau;
+        let rungs = match &self.odd {
+            Some((r, l, rungs)) if *r == self.region && *l == len => rungs.clone(),
+            _ => {
+                let m = self.model();
+                let r = self.region;
+                let rungs = ladder(&m.dynamics(r).a, &self.diffusion[r.index()], len, m.tip());
+                self.odd = Some((r, len, rungs.clone()));
+                rungs
+            }
+        };
+        (len, 0, at, Some(rungs))
+    }
+
+    /// Take `piece` in the current region: draw its end, search it for a switching; the first
+    /// point across (τ, z, its offset in units of h/2^LEVELS from the piece's start) if any.
+    fn take_piece(&mut self, piece: &Piece) -> Option<(f64, DVector<f64>, u64)> {
+        let (len, k, at_end, odd) = piece;
+        let rungs = odd
+            .clone()
+            .unwrap_or_else(|| self.ladders[self.region.index()].clone());
+        let r = self.region;
+        let (t0, t1) = (self.tau, self.tau + len);
+        let t1 = at_end.map_or(t1, |e| self.lattice_tau(e));
+        let dz0 = &self.z - self.zp(r, t0);
+        let w = self.draw(&rungs[*k].root, 0);
+        let z1 = self.zp(r, t1) + &rungs[*k].phi * &dz0 + w;
+        self.points.push((t1, z1.clone()));
+        let span = (1u64 << LEVELS) >> k;
+        let a = (t0, self.z.clone(), 0);
+        let found = self.first_crossing(&rungs, *k, a, (t1, z1.clone(), span));
+        if found.is_none() {
+            self.tau = t1;
+            self.z = z1;
+            self.at = *at_end;
+        }
+        found
+    }
+
+    /// The first point at or past the surface in (a, b] on rung `k` of `rungs` (module docs),
+    /// each point (τ, z, offset).
+    fn first_crossing(
+        &mut self,
+        rungs: &[Rung],
+        k: usize,
+        a: (f64, DVector<f64>, u64),
+        b: (f64, DVector<f64>, u64),
+    ) -> Option<(f64, DVector<f64>, u64)> {
+        let r = self.region;
+        let gb = self.gap(r, b.0, &b.1);
+        if k >= LEVELS {
+            return (gb <= 0.0).then_some(b);
+        }
+        let tm = 0.5 * (a.0 + b.0);
+        let mid = &rungs[k].mid;
+        let (da, db) = (&a.1 - self.zp(r, a.0), &b.1 - self.zp(r, b.0));
+        let zpm = self.zp(r, tm);
+        let mean = &zpm + mid.mean(&da, &db);
+        if gb > 0.0 && self.gap(r, tm, &mean) > KAPPA * mid.tip_sd {
+            return None;
+        }
+        let zm = mean + self.draw(&mid.root, 0);
+        let im = (a.2 + b.2) / 2;
+        let pos = self.points.partition_point(|p| p.0 < tm);
+        self.points.insert(pos, (tm, zm.clone()));
+        let m = (tm, zm, im);
+        if let Some(x) = self.first_crossing(rungs, k + 1, a, m.clone()) {
+            return Some(x);
+        }
+        self.first_crossing(rungs, k + 1, m, b)
+    }
+}
+
+impl Integrator for ThermalExact {
+    current_fields!();
+    fn name(&self) -> &'static str {
+        "exact-thermal"
+    }
+
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        let (region, z) = self.model.checked_start(tau, z)?;
+        let j = self.det.grid.next_index(tau) - 1;
+        self.at = (self.det.grid.tau(j) == tau).then_some((j, 0));
+        self.tau = tau;
+        self.z = z;
+        self.region = region;
+        self.points.clear();
+        Ok(())
+    }
+
+    /// Pieces of the ladder up to the next grid point or `tau_max`, or to the first switching.
+    fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        let (tau0, from) = (self.tau, self.region);
+        self.points.clear();
+        self.points.push((tau0, self.z.clone()));
+        self.last_region = from;
+        while self.tau < tau_max {
+            let piece = self.next_piece(tau_max);
+            let start = self.at;
+            if let Some((tc, zc, off)) = self.take_piece(&piece) {
+                // the path beyond the switching was drawn in the region it left
+                self.points.retain(|p| p.0 <= tc);
+                self.at = start.map(|(j, i)| {
+                    let i1 = i + off;
+                    if i1 == 1u64 << LEVELS {
+                        (j + 1, 0)
+                    } else {
+                        (j, i1)
+                    }
+                });
+                self.at = self.at.filter(|_| piece.3.is_none());
+                let step = Step::switched(self.model(), tau0, from, tc, &zc);
+                self.tau = tc;
+                self.z = zc;
+                self.region = from.other();
+                return Ok(step);
+            }
+            if self.at.is_some_and(|(_, i)| i == 0) || self.at.is_none() {
+                break;
+            }
+        }
+        crate::error::finite("thermal state", self.z.norm())?;
+        Ok(Step::plain(tau0, self.tau, from))
+    }
+
+    /// [W, Ẇ, Ẅ] of the dense state; Ẅ is the drift's (the thermal force has no value at a
+    /// point).
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        let z = self.dense_state(tau);
+        let m = self.model();
+        let n = m.modes();
+        let d = m.dynamics(self.last_region);
+        let (s, c) = (m.omega() * tau).sin_cos();
+        let rate = &d.a * &z + &d.b_const + &d.b_sin * s + &d.b_cos * c;
+        let tip = m.tip();
+        [
+            tip.dot(&z.rows(0, n)),
+            tip.dot(&z.rows(n, n)),
+            tip.dot(&rate.rows(n, n)),
+        ]
+    }
+
+    /// The drawn point at `tau`, else a draw from the bridge between the nearest drawn points
+    /// of the last step (the second stream), kept so that later draws are conditioned on it.
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        let tol = 1e-9 * self.det.grid.h;
+        let pos = self.points.partition_point(|p| p.0 < tau - tol);
+        if let Some(p) = self.points.get(pos).filter(|p| (p.0 - tau).abs() <= tol) {
+            return p.1.clone();
+        }
+        if pos == 0 || pos == self.points.len() {
+            // outside the last step: its nearest end
+            let p = &self.points[pos.min(self.points.len() - 1)];
+            return p.1.clone();
+        }
+        let ((ta, za), (tb, zb)) = (&self.points[pos - 1], &self.points[pos]);
+        let (ta, tb, za, zb) = (*ta, *tb, za.clone(), zb.clone());
+        let r = self.last_region;
+        let m = self.model();
+        let bridge = Bridge::new(
+            &m.dynamics(r).a,
+            &self.diffusion[r.index()],
+            tau - ta,
+            tb - tau,
+            m.tip(),
+        );
+        let (da, db) = (&za - self.zp(r, ta), &zb - self.zp(r, tb));
+        let z = self.zp(r, tau) + bridge.mean(&da, &db) + self.draw(&bridge.root, 1);
+        self.points.insert(pos, (tau, z.clone()));
+        z
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        Err(SimError::Unsupported {
+            integrator: "exact-thermal",
+            law: self.model.law_name(),
+            hint: "a thermally driven run has no step Jacobian: drop temperature",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
