@@ -60,17 +60,6 @@ pub struct ModelUnits {
     pub time_s: f64,
 }
 
-impl From<&crate::probe::Scales> for ModelUnits {
-    /// A probe's scales to SI.
-    fn from(s: &crate::probe::Scales) -> ModelUnits {
-        ModelUnits {
-            length_m: s.length_m,
-            force_n: s.force_n,
-            time_s: s.time_s,
-        }
-    }
-}
-
 /// One mode's thermal share (SI).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ThermalMode {

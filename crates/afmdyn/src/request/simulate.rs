@@ -3,7 +3,6 @@
 
 use super::analyses::{check_samples_per_period, IntegratorRequest};
 use super::limits::*;
-use crate::analysis::thermal::ModelUnits;
 use crate::error::SimError;
 use crate::integrate::exact::{ThermalExact, ThermalForce};
 use crate::integrate::{Integrator, IntegratorKind, IntegratorOptions};
@@ -221,8 +220,8 @@ impl SimulateRequest {
                  temperature",
             ));
         }
-        let units = ModelUnits::from(&probe.scales);
-        Ok(Some(ThermalForce::new(t, units, self.seed)))
+        let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
+        Ok(Some(ThermalForce::new(kt, self.seed)))
     }
 
     /// The warnings of the request: a temperature outside the laboratory's range.

@@ -379,10 +379,9 @@ impl FitRequest {
         let contact = names.iter().position(|n| *n == CONTACT_POINT);
         // the contact point is a tip position after the preprocessing's offset: held against
         // those, not the file's piezo heights (an instrument's are absolute: 18–23 µm)
-        let tip = &curve.tip_position;
-        outcome
-            .warnings
-            .extend(contact.and_then(|i| contact_point_warning(tip, outcome.values[i])));
+        let at = contact.map(|i| outcome.values[i]);
+        let tip = at.and_then(|v| contact_point_warning(&curve.tip_position, v));
+        outcome.warnings.extend(tip);
         Ok(FitResult {
             law,
             spring_constant: k,
@@ -395,6 +394,28 @@ impl FitRequest {
             dynamic: None,
             thermal_sigma: None,
         })
+    }
+}
+
+/// Where the fit's weights come from, in words: the thermal σ, the residuals or the σ column.
+fn noise(request: &FitRequest, r: &FitResult) -> String {
+    match (r.thermal_sigma, r.outcome.noise_estimated) {
+        (Some(s), _) => format!(
+            "the thermal σ_F = {} N at {} K (the probe's thermal spectrum below {}, detector \
+             floor {} m/√Hz; χ² in units of σ)",
+            crate::error::number(s),
+            crate::error::number(request.temperature.unwrap_or(f64::NAN)),
+            request
+                .bandwidth
+                .map_or("the time column's Nyquist frequency".into(), |b| {
+                    format!("{} Hz", crate::error::number(b))
+                }),
+            crate::error::number(request.detector_noise.unwrap_or(0.0)),
+        ),
+        (None, true) => "noise estimated from residuals (no sigma column): χ²/dof is the force \
+                         noise variance σ² (N²)"
+            .into(),
+        (None, false) => "the sigma column (χ² in units of σ)".into(),
     }
 }
 
@@ -546,18 +567,7 @@ pub(crate) fn document(request: &FitRequest, r: &FitResult) -> Value {
         "chi2": o.chi2,
         "dof": o.dof,
         "chi2_dof": o.chi2_dof,
-        "noise": match (r.thermal_sigma, o.noise_estimated) {
-            (Some(s), _) => format!(
-                "the thermal σ_F = {} N at {} K (the probe's thermal spectrum below {}, detector \
-                 floor {} m/√Hz; χ² in units of σ)",
-                crate::error::number(s),
-                crate::error::number(request.temperature.unwrap_or(f64::NAN)),
-                request.bandwidth.map_or("the time column's Nyquist frequency".into(), |b| format!("{} Hz", crate::error::number(b))),
-                crate::error::number(request.detector_noise.unwrap_or(0.0)),
-            ),
-            (None, true) => "noise estimated from residuals (no sigma column): χ²/dof is the force noise variance σ² (N²)".into(),
-            (None, false) => "the sigma column (χ² in units of σ)".into(),
-        },
+        "noise": noise(request, r),
         "sigma_thermal": r.thermal_sigma,
         "curve": {
             "tip_position": pick(&r.curve.tip_position),

@@ -29,7 +29,11 @@ impl Analysis for ThermalRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ThermalSpectrum, SimError> {
         let probe = model.probe.as_ref().expect("validated: a probe");
-        let units = ModelUnits::from(&probe.scales);
+        let units = ModelUnits {
+            length_m: probe.scales.length_m,
+            force_n: probe.scales.force_n,
+            time_s: probe.scales.time_s,
+        };
         let (t, spot) = (self.temperature(), self.spot());
         // the modes first (no frequency), then the spectrum at the frequencies they set
         let modes = thermal_spectrum(&model.params, units, t, spot, &[], progress)?;

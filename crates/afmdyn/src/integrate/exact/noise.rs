@@ -49,7 +49,6 @@
 use super::forcing::Forced;
 use super::tip::tip_v_t;
 use super::{ExactOptions, ExactPropagator};
-use crate::analysis::thermal::{ModelUnits, BOLTZMANN};
 use crate::error::SimError;
 use crate::integrate::{Integrator, IntegratorOptions, Step};
 use crate::model::CantileverModel;
@@ -78,14 +77,11 @@ pub struct ThermalForce {
 }
 
 impl ThermalForce {
-    /// The force at `temperature` (K) of a model in `units`: k_B T/(F₀ L₀) with F₀, L₀ the
-    /// newtons and metres per unit force and length (the energy unit of `units`, the one of
-    /// `crate::analysis::thermal`'s equipartition).
-    pub fn new(temperature: f64, units: ModelUnits, seed: u64) -> ThermalForce {
-        ThermalForce {
-            kt: BOLTZMANN * temperature / (units.force_n * units.length_m),
-            seed,
-        }
+    /// The force of the thermal energy `kt`, k_B T in the model's energy unit (k_B T/(F₀ L₀),
+    /// F₀ and L₀ the newtons and metres per unit force and length, the caller's SI scales:
+    /// the integrator is dimensionless), drawn from the stream of `seed`.
+    pub fn new(kt: f64, seed: u64) -> ThermalForce {
+        ThermalForce { kt, seed }
     }
 }
 

@@ -8,7 +8,7 @@
 
 use super::*;
 use crate::analysis::progress::Progress;
-use crate::analysis::thermal::thermal_spectrum;
+use crate::analysis::thermal::{thermal_spectrum, ModelUnits, BOLTZMANN};
 use crate::eigen::natural_modes;
 use crate::probe::Probe;
 
@@ -29,6 +29,11 @@ fn water_linear(z_c: f64, a0: f64) -> Probe {
         p.params.alpha2 = 0.0;
     }
     p
+}
+
+/// k_B T at 295 K in the model's energy unit of `p` (force × length).
+fn kt_model(p: &Probe) -> f64 {
+    BOLTZMANN * 295.0 / (p.scales.force_n * p.scales.length_m)
 }
 
 fn units(p: &Probe) -> ModelUnits {
@@ -52,7 +57,7 @@ fn run_counting(
         steps_per_period: min_steps,
         ..IntegratorOptions::default()
     };
-    let force = ThermalForce::new(295.0, units(p), seed);
+    let force = ThermalForce::new(kt_model(p), seed);
     let mut it = ThermalExact::new(&model, &opts, force).unwrap();
     it.reset(0.0, &model.rest()).unwrap();
     let end = periods * model.period();
