@@ -15,6 +15,7 @@ import sys
 # The page that holds each generated section (and the script that generates it).
 SECTIONS = {
     "peers": "docs/performance/propagator.md",  # scripts/peers/run.sh
+    "thermal": "docs/performance/propagator.md",  # scripts/perf-thermal.sh
     "laws": "docs/performance/laws.md",  # scripts/perf-laws.sh
     "dmt-peer": "docs/performance/laws.md",  # scripts/peers/dmt.sh
     "stability": "docs/performance/analyses.md",  # scripts/perf-stability.sh

@@ -19,9 +19,9 @@
 //! Φ and Q come from one block exponential, exp([[−A, GGᵀ], [0, Aᵀ]] ℓ) = [[·, F₁₂], [0, F₂₂]]:
 //! Φ = F₂₂ᵀ, Q = F₂₂ᵀ F₁₂ (C. F. Van Loan, "Computing integrals involving the matrix
 //! exponential", *IEEE Trans. Autom. Control* 23 (1978) 395–404, Theorem 1). w is drawn as S ζ,
-//! S = V Λ^{1/2} (Q = V Λ Vᵀ; Q is semi-definite), ζ standard normal by the Box–Muller
-//! transform (G. E. P. Box and M. E. Muller, *Ann. Math. Stat.* 29 (1958) 610) of a ChaCha8
-//! stream seeded by the seed alone: a run is a function of its seed, whatever the threads.
+//! S = V Λ^{1/2} (Q = V Λ Vᵀ; Q is semi-definite), ζ standard normal (`rand_distr`'s
+//! `StandardNormal`, the ziggurat method) from a ChaCha8 stream seeded by the seed alone: a run
+//! is a function of its seed, whatever the threads.
 //!
 //! # Switchings between two steps: the bridge
 //! Given δz at the ends a, b of an interval of length ℓ the path inside is a Gaussian bridge;
@@ -31,7 +31,9 @@
 //! and bridge gains are tabulated per region. An interval is refined — its midpoint drawn from
 //! the bridge, the left half searched first — when the gap g = ±V_T at its right end is ≤ 0 or
 //! the gap of the bridge's mean at its midpoint is within [`KAPPA`] standard deviations of the
-//! surface (g's bridge standard deviation is fixed per level); at level [`LEVELS`] the first
+//! surface (g's bridge standard deviation is fixed per level; the mean's gap is a linear form in
+//! the ends' δz, its two rows tabulated per rung, so that the test costs two dot products and
+//! no draw); at level [`LEVELS`] the first
 //! point with g ≤ 0 is the switching. **Error**: the switching time is located to within
 //! h/2^LEVELS (h/4096) and the state there is the path's (its gap past the surface by at most
 //! |ġ| h/4096); an excursion across the surface is missed only where every tested midpoint of
@@ -57,6 +59,7 @@ use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
 use std::sync::Arc;
 
 /// The levels of the dyadic ladder below a grid step: a switching is located to h/2^LEVELS.
@@ -146,6 +149,9 @@ struct Bridge {
     root: DMatrix<f64>,
     /// The standard deviation of the tip's deflection at the point.
     tip_sd: f64,
+    /// The rows u, v of the tip's deflection of the mean, tip·(Φ₁ δz_a + B (δz_b − Φ δz_a))
+    /// = u·δz_a + v·δz_b (each `[2N]`).
+    rows: [DVector<f64>; 2],
 }
 
 impl Bridge {
@@ -171,12 +177,15 @@ impl Bridge {
         let root = root(&(0.5 * (&cov + cov.transpose())));
         let n = tip.len();
         let tip_sd = (root.rows(0, n).transpose() * tip).norm();
+        let v = gain.rows(0, n).transpose() * tip;
+        let u = phi1.rows(0, n).transpose() * tip - phi.transpose() * &v;
         Bridge {
             phi1,
             gain,
             phi,
             root,
             tip_sd,
+            rows: [u, v],
         }
     }
 
@@ -186,16 +195,25 @@ impl Bridge {
     }
 }
 
-/// One rung of a ladder: the step of length ℓ_k (Φ and Q's root) and the bridge to its middle.
+/// One rung of a ladder: the step of length ℓ_k (Φ and Q's root), the bridge to its middle and
+/// (sin, cos) Ωℓ_k/2, the turn of the drive's phase to it.
 #[derive(Debug, Clone)]
 struct Rung {
     phi: DMatrix<f64>,
     root: DMatrix<f64>,
     mid: Bridge,
+    half_turn: (f64, f64),
 }
 
-/// The ladder of region (`a`, `d`) from a step of `len`: rungs k = 0..=LEVELS of ℓ_k = len/2^k.
-fn ladder(a: &DMatrix<f64>, d: &DMatrix<f64>, len: f64, tip: &DVector<f64>) -> Arc<[Rung]> {
+/// The ladder of region (`a`, `d`) from a step of `len` at drive frequency `omega`: rungs
+/// k = 0..=LEVELS of ℓ_k = len/2^k.
+fn ladder(
+    a: &DMatrix<f64>,
+    d: &DMatrix<f64>,
+    len: f64,
+    tip: &DVector<f64>,
+    omega: f64,
+) -> Arc<[Rung]> {
     let steps: Vec<(DMatrix<f64>, DMatrix<f64>)> = (0..=LEVELS + 1)
         .map(|k| van_loan(a, d, len / (1u64 << k) as f64))
         .collect();
@@ -215,13 +233,22 @@ fn ladder(a: &DMatrix<f64>, d: &DMatrix<f64>, len: f64, tip: &DVector<f64>) -> A
                 phi: phi.clone(),
                 root: root(q),
                 mid,
+                half_turn: (0.5 * omega * len / (1u64 << k) as f64).sin_cos(),
             }
         })
         .collect()
 }
 
-/// A point of the path: τ, its position on the ladder (`None` off it) and z.
+/// A point of the path: τ and z.
 type Point = (f64, DVector<f64>);
+
+/// A point of a piece being searched: τ, (sin, cos) Ωτ, z, its offset in units of h/2^LEVELS.
+type Probe = (f64, (f64, f64), DVector<f64>, u64);
+
+/// (sin, cos) of θ + φ from (sin, cos) θ and (sin, cos) φ.
+fn turn((s, c): (f64, f64), (sp, cp): (f64, f64)) -> (f64, f64) {
+    (s * cp + c * sp, c * cp - s * sp)
+}
 
 /// The exact stochastic step of the piecewise-linear model (module docs), an [`Integrator`]
 /// whose state carries the thermal force.
@@ -240,10 +267,12 @@ pub struct ThermalExact {
     odd: Option<(Region, f64, Arc<[Rung]>)>,
     rng: ChaCha8Rng,
     dense_rng: ChaCha8Rng,
-    /// The second normal of the last Box–Muller pair of each stream.
-    spare: [Option<f64>; 2],
     tau: f64,
+    /// (sin, cos) Ωτ at `tau`.
+    sc: (f64, f64),
     z: DVector<f64>,
+    /// Scratch of a piece: δz at its start, ζ, δz at its end (each `[2N]`).
+    scratch: [DVector<f64>; 3],
     region: Region,
     /// The position on the ladder: grid step j and the offset i in units of h/2^LEVELS
     /// (`None` off it).
@@ -286,8 +315,11 @@ impl ThermalExact {
         )?;
         let diffusion = [Region::Free, Region::Contact].map(|r| diffusion(model, r, force.kt));
         let h = det.grid.h;
-        let ladders = [Region::Free, Region::Contact]
-            .map(|r| ladder(&model.dynamics(r).a, &diffusion[r.index()], h, model.tip()));
+        let omega = model.omega();
+        let ladders = [Region::Free, Region::Contact].map(|r| {
+            let a = &model.dynamics(r).a;
+            ladder(a, &diffusion[r.index()], h, model.tip(), omega)
+        });
         let n = 2 * model.modes();
         Ok(ThermalExact {
             det,
@@ -298,9 +330,10 @@ impl ThermalExact {
             odd: None,
             rng: ChaCha8Rng::seed_from_u64(force.seed),
             dense_rng: ChaCha8Rng::seed_from_u64(force.seed ^ DENSE_STREAM),
-            spare: [None, None],
             tau: 0.0,
+            sc: (0.0, 1.0),
             z: DVector::zeros(n),
+            scratch: [0, 1, 2].map(|_| DVector::zeros(n)),
             region: Region::Free,
             at: Some((0, 0)),
             points: Vec::new(),
@@ -322,47 +355,68 @@ impl ThermalExact {
         &self.model
     }
 
-    /// A standard normal from stream `s` (0 the path's, 1 the dense output's), Box–Muller.
-    fn normal(&mut self, s: usize) -> f64 {
-        if let Some(x) = self.spare[s].take() {
-            return x;
-        }
+    /// ζ, standard normals from stream `s` (0 the path's, 1 the dense output's).
+    fn normals(&mut self, s: usize, zeta: &mut DVector<f64>) {
         let rng = if s == 0 {
             &mut self.rng
         } else {
             &mut self.dense_rng
         };
-        // u₁ in (0, 1]: ln u₁ finite
-        let u1 = 1.0 - rng.random::<f64>();
-        let u2: f64 = rng.random();
-        let r = (-2.0 * u1.ln()).sqrt();
-        let (s2, c2) = (std::f64::consts::TAU * u2).sin_cos();
-        self.spare[s] = Some(r * s2);
-        r * c2
+        zeta.iter_mut()
+            .for_each(|x| *x = rng.sample(StandardNormal));
     }
 
     /// S ζ for a root S (2N × 2N) from stream `s`.
     fn draw(&mut self, root: &DMatrix<f64>, s: usize) -> DVector<f64> {
-        let zeta = DVector::from_fn(root.ncols(), |_, _| self.normal(s));
+        let mut zeta = DVector::zeros(root.ncols());
+        self.normals(s, &mut zeta);
         root * zeta
     }
 
-    /// z_p(τ) of region `r`.
-    fn zp(&self, r: Region, tau: f64) -> DVector<f64> {
+    /// z_p(τ) of region `r` at (sin, cos) Ωτ = `sc`.
+    fn zp(&self, r: Region, (s, c): (f64, f64)) -> DVector<f64> {
         let f: &Forced = &self.det.forced[r.index()];
-        let (s, c) = (self.model().omega() * tau).sin_cos();
         &f.p0 + &f.ps * s + &f.pc * c
     }
 
-    /// The gap ±V_T (+ free, − in contact) of z at τ in region `r`.
-    fn gap(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
-        let sc = (self.model().omega() * tau).sin_cos();
-        let v = tip_v_t(self.model(), z.as_slice(), sc).0;
+    /// z − z_p(τ) of region `r`, (sin, cos) Ωτ = `sc`, into `out`.
+    fn dz_into(&self, r: Region, (s, c): (f64, f64), z: &DVector<f64>, out: &mut DVector<f64>) {
+        let f: &Forced = &self.det.forced[r.index()];
+        out.copy_from(z);
+        *out -= &f.p0;
+        out.axpy(-s, &f.ps, 1.0);
+        out.axpy(-c, &f.pc, 1.0);
+    }
+
+    /// The sign of the gap in region `r`: V_T is the gap in free flight, −V_T in contact.
+    fn sign(r: Region) -> f64 {
         if r == Region::Free {
-            v
+            1.0
         } else {
-            -v
+            -1.0
         }
+    }
+
+    /// The gap ±V_T (+ free, − in contact) of z in region `r`, (sin, cos) Ωτ = `sc`.
+    fn gap(&self, r: Region, sc: (f64, f64), z: &DVector<f64>) -> f64 {
+        Self::sign(r) * tip_v_t(self.model(), z.as_slice(), sc).0
+    }
+
+    /// The gap of the bridge's mean at the middle of an interval of rung `rung` of region `r`
+    /// from δz at its ends, (sin, cos) Ω of the middle `scm`: the mean's tip deflection
+    /// u·δz_a + v·δz_b over z_p's W_p (module docs).
+    fn mid_gap(
+        &self,
+        r: Region,
+        rung: &Rung,
+        scm: (f64, f64),
+        da: &DVector<f64>,
+        db: &DVector<f64>,
+    ) -> f64 {
+        let [w0, ws, wc] = self.det.forced[r.index()].wp;
+        let [u, v] = &rung.mid.rows;
+        let w = w0 + ws * scm.0 + wc * scm.1 + u.dot(da) + v.dot(db);
+        Self::sign(r) * self.model().v_t_at(scm, [w, 0.0, 0.0])[0]
     }
 
     /// τ of ladder position (j, i).
@@ -401,7 +455,8 @@ impl ThermalExact {
             _ => {
                 let m = self.model();
                 let r = self.region;
-                let rungs = ladder(&m.dynamics(r).a, &self.diffusion[r.index()], len, m.tip());
+                let (a, d) = (&m.dynamics(r).a, &self.diffusion[r.index()]);
+                let rungs = ladder(a, d, len, m.tip(), m.omega());
                 self.odd = Some((r, len, rungs.clone()));
                 rungs
             }
@@ -416,51 +471,65 @@ impl ThermalExact {
         let rungs = odd
             .clone()
             .unwrap_or_else(|| self.ladders[self.region.index()].clone());
+        let rung = &rungs[*k];
         let r = self.region;
-        let (t0, t1) = (self.tau, self.tau + len);
-        let t1 = at_end.map_or(t1, |e| self.lattice_tau(e));
-        let dz0 = &self.z - self.zp(r, t0);
-        let w = self.draw(&rungs[*k].root, 0);
-        let z1 = self.zp(r, t1) + &rungs[*k].phi * &dz0 + w;
+        let (t0, sc0) = (self.tau, self.sc);
+        let t1 = at_end.map_or(t0 + len, |e| self.lattice_tau(e));
+        let sc1 = (self.model().omega() * t1).sin_cos();
+        // δz₁ = Φ δz₀ + S ζ, z₁ = z_p(t₁) + δz₁
+        let [mut dz0, mut zeta, mut dz1] = std::mem::take(&mut self.scratch);
+        self.dz_into(r, sc0, &self.z, &mut dz0);
+        self.normals(0, &mut zeta);
+        dz1.gemv(1.0, &rung.root, &zeta, 0.0);
+        dz1.gemv(1.0, &rung.phi, &dz0, 1.0);
+        let z1 = self.zp(r, sc1) + &dz1;
+        let clear = self.gap(r, sc1, &z1) > 0.0
+            && self.mid_gap(r, rung, turn(sc0, rung.half_turn), &dz0, &dz1)
+                > KAPPA * rung.mid.tip_sd;
+        self.scratch = [dz0, zeta, dz1];
         self.points.push((t1, z1.clone()));
         let span = (1u64 << LEVELS) >> k;
-        let a = (t0, self.z.clone(), 0);
-        let found = self.first_crossing(&rungs, *k, a, (t1, z1.clone(), span));
+        let found = if clear {
+            None
+        } else {
+            let a = (t0, sc0, self.z.clone(), 0);
+            self.first_crossing(&rungs, *k, a, (t1, sc1, z1.clone(), span))
+        };
         if found.is_none() {
             self.tau = t1;
+            self.sc = sc1;
             self.z = z1;
             self.at = *at_end;
         }
         found
     }
 
-    /// The first point at or past the surface in (a, b] on rung `k` of `rungs` (module docs),
-    /// each point (τ, z, offset).
+    /// The first point at or past the surface in (a, b] on rung `k` of `rungs` (module docs).
     fn first_crossing(
         &mut self,
         rungs: &[Rung],
         k: usize,
-        a: (f64, DVector<f64>, u64),
-        b: (f64, DVector<f64>, u64),
+        a: Probe,
+        b: Probe,
     ) -> Option<(f64, DVector<f64>, u64)> {
         let r = self.region;
-        let gb = self.gap(r, b.0, &b.1);
+        let gb = self.gap(r, b.1, &b.2);
         if k >= LEVELS {
-            return (gb <= 0.0).then_some(b);
+            return (gb <= 0.0).then_some((b.0, b.2, b.3));
         }
-        let tm = 0.5 * (a.0 + b.0);
+        let (tm, scm) = (0.5 * (a.0 + b.0), turn(a.1, rungs[k].half_turn));
         let mid = &rungs[k].mid;
-        let (da, db) = (&a.1 - self.zp(r, a.0), &b.1 - self.zp(r, b.0));
-        let zpm = self.zp(r, tm);
-        let mean = &zpm + mid.mean(&da, &db);
-        if gb > 0.0 && self.gap(r, tm, &mean) > KAPPA * mid.tip_sd {
+        let (mut da, mut db) = (DVector::zeros(a.2.len()), DVector::zeros(b.2.len()));
+        self.dz_into(r, a.1, &a.2, &mut da);
+        self.dz_into(r, b.1, &b.2, &mut db);
+        if gb > 0.0 && self.mid_gap(r, &rungs[k], scm, &da, &db) > KAPPA * mid.tip_sd {
             return None;
         }
-        let zm = mean + self.draw(&mid.root, 0);
-        let im = (a.2 + b.2) / 2;
+        let zm = self.zp(r, scm) + mid.mean(&da, &db) + self.draw(&mid.root, 0);
+        let im = (a.3 + b.3) / 2;
         let pos = self.points.partition_point(|p| p.0 < tm);
         self.points.insert(pos, (tm, zm.clone()));
-        let m = (tm, zm, im);
+        let m = (tm, scm, zm, im);
         if let Some(x) = self.first_crossing(rungs, k + 1, a, m.clone()) {
             return Some(x);
         }
@@ -479,6 +548,7 @@ impl Integrator for ThermalExact {
         let j = self.det.grid.next_index(tau) - 1;
         self.at = (self.det.grid.tau(j) == tau).then_some((j, 0));
         self.tau = tau;
+        self.sc = (self.model.omega() * tau).sin_cos();
         self.z = z;
         self.region = region;
         self.points.clear();
@@ -508,6 +578,7 @@ impl Integrator for ThermalExact {
                 self.at = self.at.filter(|_| piece.3.is_none());
                 let step = Step::switched(self.model(), tau0, from, tc, &zc);
                 self.tau = tc;
+                self.sc = (self.model().omega() * tc).sin_cos();
                 self.z = zc;
                 self.region = from.other();
                 return Ok(step);
@@ -561,8 +632,12 @@ impl Integrator for ThermalExact {
             tb - tau,
             m.tip(),
         );
-        let (da, db) = (&za - self.zp(r, ta), &zb - self.zp(r, tb));
-        let z = self.zp(r, tau) + bridge.mean(&da, &db) + self.draw(&bridge.root, 1);
+        let omega = m.omega();
+        let [sa, st, sb] = [ta, tau, tb].map(|t| (omega * t).sin_cos());
+        let (mut da, mut db) = (DVector::zeros(za.len()), DVector::zeros(zb.len()));
+        self.dz_into(r, sa, &za, &mut da);
+        self.dz_into(r, sb, &zb, &mut db);
+        let z = self.zp(r, st) + bridge.mean(&da, &db) + self.draw(&bridge.root, 1);
         self.points.insert(pos, (tau, z.clone()));
         z
     }

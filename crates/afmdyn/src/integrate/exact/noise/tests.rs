@@ -143,7 +143,7 @@ fn a_free_lever_holds_equipartition() {
     let q = crate::eigen::quality_factors(g);
     let n = model.modes();
     let kt = it.force().kt;
-    let zp = |t: f64| it.zp(Region::Free, t);
+    let zp = |t: f64| it.zp(Region::Free, (it.model().omega() * t).sin_cos());
     let mut sums = vec![0.0; n + 1];
     let skip = series.len() / 20;
     for (t, z) in &series[skip..] {
@@ -186,7 +186,8 @@ fn a_free_series_has_the_thermal_spectrum() {
     let n = model.modes();
     let x: Vec<f64> = (series.iter())
         .map(|(t, z)| {
-            let dz = DVector::from_column_slice(z) - it.zp(Region::Free, *t);
+            let dz = DVector::from_column_slice(z)
+                - it.zp(Region::Free, (it.model().omega() * t).sin_cos());
             model.tip().dot(&dz.rows(0, n)) * p.scales.length_m
         })
         .collect();
@@ -272,13 +273,22 @@ fn the_bridge_finds_the_crossings_a_coarse_grid_misses() {
     let (f_coarse, f_fine) = (c_coarse / total, c_fine / total);
     // grid points in contact, and their changes of region: what the grid alone sees
     let h = it.det.grid.h;
+    let sc = |t: f64| (it.model().omega() * t).sin_cos();
     let on_grid: Vec<&(f64, Vec<f64>)> = (coarse.iter())
         .filter(|(t, _)| ((t / h) - (t / h).round()).abs() < 1e-6)
         .collect();
     let grid_changes = (on_grid.windows(2))
         .filter(|w| {
-            (it.gap(Region::Free, w[0].0, &DVector::from_column_slice(&w[0].1)) > 0.0)
-                != (it.gap(Region::Free, w[1].0, &DVector::from_column_slice(&w[1].1)) > 0.0)
+            (it.gap(
+                Region::Free,
+                sc(w[0].0),
+                &DVector::from_column_slice(&w[0].1),
+            ) > 0.0)
+                != (it.gap(
+                    Region::Free,
+                    sc(w[1].0),
+                    &DVector::from_column_slice(&w[1].1),
+                ) > 0.0)
         })
         .count();
     // the contact episodes are independent over the first mode's correlation time
