@@ -156,13 +156,7 @@ def _finish_thermal(a: Args) -> xr.Dataset:
     mode's share over ``mode`` (``modes_*`` variables); ``attrs["summary"]`` is the document."""
     p, probe = _params(a["params"], a["model"])
     d = _door("thermal", "thermal", a["progress"], p, probe, _request(a))
-    ds = _layout.dataset(d["datasets"]["thermal"])
-    modes = _layout.dataset(d["datasets"]["modes"])
-    for name, var in modes.data_vars.items():
-        ds[f"modes_{name}"] = var
-    ds.attrs = {"title": "afmdyn thermal", "summary": d["json"],
-                **{k: v for k, v in d["facts"].items() if isinstance(v, (int, float))}}
-    return ds
+    return _with_modes(d, "thermal", "afmdyn thermal")
 
 
 def _finish_calibrate(a: Args) -> xr.Dataset:
@@ -173,11 +167,17 @@ def _finish_calibrate(a: Args) -> xr.Dataset:
               for k in ("frequency", "spectral_density", "bands")}
     p, probe = _params(a["params"], a["model"])
     d = _door("calibrate", "calibrate", a["progress"], p, probe, _request(a, **arrays))
-    ds = _layout.dataset(d["datasets"]["spectrum"])
+    return _with_modes(d, "spectrum", "afmdyn calibrate")
+
+
+def _with_modes(d: dict, main: str, title: str) -> xr.Dataset:
+    """The door's dataset ``main`` with its ``modes`` dataset's variables as ``modes_*``, the
+    document as ``attrs["summary"]`` and the numeric facts as attributes."""
+    ds = _layout.dataset(d["datasets"][main])
     modes = _layout.dataset(d["datasets"]["modes"])
     for name, var in modes.data_vars.items():
         ds[f"modes_{name}"] = var
-    ds.attrs = {"title": "afmdyn calibrate", "summary": d["json"],
+    ds.attrs = {"title": title, "summary": d["json"],
                 **{k: v for k, v in d["facts"].items() if isinstance(v, (int, float))}}
     return ds
 

@@ -5,7 +5,7 @@
 
 use crate::analysis::calibration::{calibrate, invols, Calibration, Measured, ModeCalibration};
 use crate::analysis::progress::Progress;
-use crate::analysis::thermal::{thermal_spectrum, ModelUnits};
+use crate::analysis::thermal::thermal_spectrum;
 use crate::error::SimError;
 use crate::hydro::Medium;
 use crate::report::{self, Convergence};
@@ -115,11 +115,7 @@ impl Analysis for CalibrateRequest {
             let s = sensitivity.expect("validated: an InvOLS with volts");
             f_psd.1.iter_mut().for_each(|v| *v *= s * s);
         }
-        let units = ModelUnits {
-            length_m: probe.scales.length_m,
-            force_n: probe.scales.force_n,
-            time_s: probe.scales.time_s,
-        };
+        let units = super::model_units(&probe.scales);
         let t = self.temperature();
         let spectrum = thermal_spectrum(&model.params, units, t, self.spot(), &[], progress)?;
         let modes = &spectrum.modes[..self.peaks.unwrap_or(spectrum.modes.len())];

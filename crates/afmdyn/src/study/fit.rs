@@ -46,9 +46,7 @@ impl FitRequest {
         time: Option<&[f64]>,
         progress: &Progress,
     ) -> Result<f64, SimError> {
-        use crate::analysis::thermal::{
-            apparent_mean_square_in_band, thermal_spectrum, ModelUnits,
-        };
+        use crate::analysis::thermal::{apparent_mean_square_in_band, thermal_spectrum};
         let probe = model.probe.as_ref().expect("checked");
         let nyquist = time
             .filter(|t| t.len() > 1)
@@ -60,11 +58,7 @@ impl FitRequest {
                 "the thermal σ needs the detection bandwidth (Hz), or a time column".into(),
             )
         })?;
-        let units = ModelUnits {
-            length_m: probe.scales.length_m,
-            force_n: probe.scales.force_n,
-            time_s: probe.scales.time_s,
-        };
+        let units = super::model_units(&probe.scales);
         let s = thermal_spectrum(&model.params, units, temperature, 1.0, &[], progress)?;
         let floor = self.detector_noise.unwrap_or(0.0).powi(2) * b;
         let k = probe.calibration.spring_constant;

@@ -100,6 +100,7 @@ pub use peakforce::PeakForceResult;
 pub(crate) use pool::in_pool;
 
 use crate::analysis::progress::Progress;
+use crate::analysis::thermal::ModelUnits;
 use crate::error::SimError;
 use crate::study::checkpoint::CheckpointError;
 use serde_json::Value;
@@ -377,5 +378,15 @@ where
         Err(StudyError::Sim(e)) => Err(e),
         // a memory store opens, appends and finishes without fail
         Err(StudyError::Store(e)) => unreachable!("memory store: {e}"),
+    }
+}
+
+/// The SI scales of a probe (metres, newtons, seconds per model unit) as the thermal analyses
+/// take them.
+pub(crate) fn model_units(s: &crate::probe::Scales) -> ModelUnits {
+    ModelUnits {
+        length_m: s.length_m,
+        force_n: s.force_n,
+        time_s: s.time_s,
     }
 }

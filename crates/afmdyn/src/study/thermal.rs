@@ -3,7 +3,7 @@
 //! presentation.
 
 use crate::analysis::progress::Progress;
-use crate::analysis::thermal::{thermal_spectrum, ModelUnits, ThermalSpectrum};
+use crate::analysis::thermal::{thermal_spectrum, ThermalSpectrum};
 use crate::error::SimError;
 use crate::report::{self, Convergence};
 use crate::request::run::{Analysis, Resolved};
@@ -29,11 +29,7 @@ impl Analysis for ThermalRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ThermalSpectrum, SimError> {
         let probe = model.probe.as_ref().expect("validated: a probe");
-        let units = ModelUnits {
-            length_m: probe.scales.length_m,
-            force_n: probe.scales.force_n,
-            time_s: probe.scales.time_s,
-        };
+        let units = super::model_units(&probe.scales);
         let (t, spot) = (self.temperature(), self.spot());
         // the modes first (no frequency), then the spectrum at the frequencies they set
         let modes = thermal_spectrum(&model.params, units, t, spot, &[], progress)?;
