@@ -25,7 +25,7 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from ._common import Model  # noqa: F401 (afmdyn._api.Model, as before)
 from ._common import _attrs, _door, _params, _probe_text, _request, _start, _state
-from . import _layout
+from . import _ibw, _layout
 from ._results import RegionSpectrum, Spectrum
 
 if TYPE_CHECKING:
@@ -162,12 +162,29 @@ def _finish_thermal(a: Args) -> xr.Dataset:
 def _finish_calibrate(a: Args) -> xr.Dataset:
     """A lever's calibration from its measured thermal spectrum (``afmdyn calibrate``): the
     spectrum and the fitted oscillators over ``frequency``, each mode's estimates over ``mode``
-    (``modes_*`` variables); ``attrs["summary"]`` is the document."""
+    (``modes_*`` variables); ``attrs["summary"]`` is the document. A ``psd`` ending in
+    ``.ibw`` is an Igor binary wave, read here (``_ibw``) into the arrays."""
+    if a["psd"] is not None and str(a["psd"]).lower().endswith(".ibw"):
+        a = _ibw_arrays(a)
     arrays = {k: [float(v) for v in a[k]] if a[k] is not None else []
               for k in ("frequency", "spectral_density", "bands")}
     p, probe = _params(a["params"], a["model"])
     d = _door("calibrate", "calibrate", a["progress"], p, probe, _request(a, **arrays))
     return _with_modes(d, "spectrum", "afmdyn calibrate")
+
+
+def _ibw_arrays(a: Args) -> Args:
+    """``a`` with the thermal wave ``psd`` (``.ibw``) read into ``frequency`` and
+    ``spectral_density``, ``volts`` from its units."""
+    if a["frequency"] is not None or a["spectral_density"] is not None:
+        raise ValueError("psd: give the file psd or the arrays frequency and spectral_density, "
+                         "not both")
+    frequency, density, volts = _ibw.read_spectrum(str(a["psd"]))
+    if a["volts"] and not volts:
+        raise ValueError(f"volts: {a['psd']} is in m²/Hz (its data units), not the detector's "
+                         "V²/Hz; drop volts")
+    return {**a, "psd": None, "frequency": frequency, "spectral_density": density,
+            "volts": volts}
 
 
 def _with_modes(d: dict, main: str, title: str) -> xr.Dataset:

@@ -726,7 +726,8 @@ def calibrate(
     the static and each mode's effective spring constant by the thermal method (Butt & Jaschke
     1995, the model's correction factor) and by Sader's method (Sader, Chon & Mulvaney 1999;
     Lozano et al. 2010) and their agreement; the InvOLS of a force curve's contact slope. The
-    spectrum is a CSV file ``psd`` (columns ``frequency``, ``psd``) or the arrays ``frequency`` and
+    spectrum is a CSV file ``psd`` (columns ``frequency``, ``psd``), an Igor binary wave ``psd``
+    (``.ibw``, as Asylum Research's software saves a thermal) or the arrays ``frequency`` and
     ``spectral_density``.
 
     Args:
@@ -744,7 +745,11 @@ def calibrate(
         psd: A CSV file with the columns ``frequency`` (Hz, increasing) and ``psd`` (the
             one-sided power spectral density, m²/Hz, or V²/Hz with ``volts``), read through
             the bounded reader (instead of the columns ``frequency`` and
-            ``spectral_density``).
+            ``spectral_density``). In Python also an Igor binary wave (``.ibw``, read by
+            ``igor2``: ``pip install igor2``): one-dimensional, its x scaling the frequency
+            in Hz, its data units a PSD's (``m^2/Hz``, ``V^2/Hz``) or an amplitude spectral
+            density's (``m/√Hz``, ``V/√Hz``; squared), which also set ``volts``; other units
+            are refused, and a bin at 0 Hz is dropped.
         signal: What the spectrum measures: ``apparent-deflection`` (an optical lever's, the
             default) or ``deflection`` (the tip's, an interferometer's).
         spectral_density: The one-sided PSD at them (m²/Hz, or V²/Hz with ``volts``; > 0),
