@@ -26,11 +26,11 @@ def _units(raw: object) -> str:
     if isinstance(raw, np.ndarray):
         raw = b"".join(bytes(c) for c in raw.ravel())
     if isinstance(raw, bytes):
-        raw = raw.split(b"\0")[0]
+        head = raw.split(b"\0")[0]
         try:
-            raw = raw.decode("utf-8")
+            raw = head.decode("utf-8")
         except UnicodeDecodeError:
-            raw = raw.decode("latin-1")
+            raw = head.decode("latin-1")
     text = re.sub(r"\s+", "", str(raw))
     text = text.replace("²", "^2")
     return re.sub(r"√Hz|sqrt\(Hz\)|Hz\^\(1/2\)|Hz\^½|Hz\^0\.5|rtHz", "Hz^0.5", text)
@@ -59,7 +59,7 @@ def read_spectrum(path: str) -> Tuple[List[float], List[float], bool]:
             Igor binary wave, not one-dimensional, x units other than Hz, data units neither
             a PSD's nor an ASD's, values not finite."""
     try:
-        from igor2 import binarywave
+        from igor2 import binarywave  # type: ignore[import-untyped]
     except ImportError as e:
         raise ValueError(f"psd: {path} is an Igor binary wave; reading it needs the igor2 "
                          "package (pip install igor2)") from e
