@@ -60,6 +60,7 @@ mod laws_table;
 mod layouts;
 mod layouts_documents;
 mod limits;
+mod limits_table;
 mod liquid;
 mod maps;
 mod modal;
