@@ -7,7 +7,6 @@
 #![cfg(not(feature = "toy-law"))]
 
 use afmdyn::contact::LAWS;
-use std::path::Path;
 
 const BEGIN: &str = "<!-- laws-table: generated from afmdyn::contact::LAWS by crates/afmdyn/tests/laws_table.rs; do not edit -->";
 const END: &str = "<!-- end of laws-table -->";
@@ -58,22 +57,5 @@ fn table() -> String {
 
 #[test]
 fn the_docs_table_of_laws_is_the_registry() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/contact-laws.md");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let (head, rest) = text
-        .split_once(BEGIN)
-        .expect("docs/contact-laws.md lacks the laws-table marker");
-    let (_, tail) = rest
-        .split_once(END)
-        .expect("docs/contact-laws.md lacks the end marker");
-    let want = format!("{head}{BEGIN}\n{}{END}{tail}", table());
-    if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
-        std::fs::write(&path, want).unwrap();
-    } else {
-        assert!(
-            text == want,
-            "docs/contact-laws.md's table of laws differs from the registry; regenerate with \
-             AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::laws_table::"
-        );
-    }
+    super::common::generated_section("docs/contact-laws.md", BEGIN, END, &table(), "laws_table");
 }

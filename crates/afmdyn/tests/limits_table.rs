@@ -31,7 +31,6 @@ use afmdyn::request::limits::{
     MAX_REQUEST_WORK, MAX_RUN_PERIODS, MAX_SAMPLES_PER_PERIOD, MAX_SERIES_BYTES,
     MAX_SERIES_MEMORY_BYTES, MAX_THREADS, MAX_TRACE_BYTES, TOLERANCE_RANGE,
 };
-use std::path::Path;
 
 const BEGIN: &str = "<!-- limits-table: generated from the library's constants by \
                      crates/afmdyn/tests/limits_table.rs; do not edit -->";
@@ -351,22 +350,5 @@ fn table() -> String {
 
 #[test]
 fn the_docs_table_of_limits_is_the_librarys() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/outputs.md");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let (head, rest) = text
-        .split_once(BEGIN)
-        .expect("docs/outputs.md lacks the limits-table marker");
-    let (_, tail) = rest
-        .split_once(END)
-        .expect("docs/outputs.md lacks the end marker");
-    let want = format!("{head}{BEGIN}\n{}{END}{tail}", table());
-    if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
-        std::fs::write(&path, want).unwrap();
-    } else {
-        assert!(
-            text == want,
-            "docs/outputs.md's table of limits differs from the library; regenerate with \
-             AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::limits_table::"
-        );
-    }
+    super::common::generated_section("docs/outputs.md", BEGIN, END, &table(), "limits_table");
 }

@@ -469,3 +469,25 @@ pub fn fit_hertz_probe() -> afmdyn::request::Resolved {
         probe: Some(p),
     }
 }
+
+/// The generated section of the doc `doc` (a path from the repository's root) between the
+/// markers `begin` and `end` equals `body`, or (`AFMDYN_WRITE_SCHEMA=1`) is rewritten to it;
+/// `module` names the test module that regenerates it (`laws_table`).
+pub fn generated_section(doc: &str, begin: &str, end: &str, body: &str, module: &str) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(doc);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (head, rest) = (text.split_once(begin)).unwrap_or_else(|| panic!("{doc} lacks {begin}"));
+    let (_, tail) = (rest.split_once(end)).unwrap_or_else(|| panic!("{doc} lacks {end}"));
+    let want = format!("{head}{begin}\n{body}{end}{tail}");
+    if std::env::var_os("AFMDYN_WRITE_SCHEMA").is_some_and(|v| v == "1") {
+        std::fs::write(&path, want).unwrap();
+    } else {
+        assert!(
+            text == want,
+            "{doc}'s generated section differs from the library; regenerate with \
+             AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::{module}::"
+        );
+    }
+}
