@@ -577,9 +577,6 @@ impl_request! {
 
 pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 
-#[cfg(test)]
-mod tests;
-
 impl_request! {
     OrbitRequest, "orbit",
     advice = "ask for a shorter transient (max_periods) or a lower max_period";
@@ -750,3 +747,6 @@ pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Val
     }
     doc
 }
+
+#[cfg(test)]
+mod tests;

@@ -6,7 +6,6 @@
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::fit::MAX_FIT_ROWS;
 use super::limits::Cost;
-use super::run::{Request, Resolved};
 use super::thermal::{check_thermal, temperature_warnings, DEFAULT_TEMPERATURE};
 use crate::analysis::calibration::Signal;
 use crate::error::SimError;
@@ -118,22 +117,22 @@ impl CalibrateRequest {
     }
 }
 
-impl Request for CalibrateRequest {
-    const COST_ADVICE: &'static str = "give a shorter spectrum";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        check_thermal(model, self.temperature(), self.spot())?;
+impl_request! {
+    CalibrateRequest, "calibrate", advice = "give a shorter spectrum";
+    validate |r, model| {
+        check_thermal(model, r.temperature(), r.spot())?;
         let n = model.params.modes;
         let refuse = |name, value: String, why| Err(SimError::out_of_range(name, value, why));
-        match (&self.psd, self.frequency.is_empty() && self.spectral_density.is_empty()) {
+        match (&r.psd, r.frequency.is_empty() && r.spectral_density.is_empty()) {
             (Some(_), false) => return refuse("psd", "given with the columns".into(), "give either a psd file or the columns frequency and spectral_density"),
             (None, true) => return refuse("psd", "missing".into(), "a measured spectrum is needed: a CSV file (columns frequency, psd) or the columns frequency and spectral_density"),
-            (None, false) => Self::check_spectrum(&self.frequency, &self.spectral_density)?,
+            (None, false) => Self::check_spectrum(&r.frequency, &r.spectral_density)?,
             (Some(_), true) => {}
         }
-        if let Some(m) = self.peaks.filter(|m| !(1..=n).contains(m)) {
+        if let Some(m) = r.peaks.filter(|m| !(1..=n).contains(m)) {
             return refuse("peaks", m.to_string(), "1 to the probe's number of modes");
         }
-        let pairs = self.bands.chunks(2);
+        let pairs = r.bands.chunks(2);
         if let Some(b) = pairs
             .clone()
             .find(|b| !matches!(b, [lo, hi] if *lo >= 0.0 && hi > lo && hi.is_finite()))
@@ -144,7 +143,7 @@ impl Request for CalibrateRequest {
                 "a pair lo, hi per mode with 0 ≤ lo < hi (Hz)",
             );
         }
-        if let Some(s) = self.invols.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        if let Some(s) = r.invols.filter(|s| !(s.is_finite() && *s > 0.0)) {
             return refuse(
                 "invols",
                 crate::error::number(s),
@@ -152,9 +151,9 @@ impl Request for CalibrateRequest {
             );
         }
         match (
-            self.volts,
-            self.invols.is_some(),
-            self.force_curve.is_some(),
+            r.volts,
+            r.invols.is_some(),
+            r.force_curve.is_some(),
         ) {
             (true, false, false) => refuse(
                 "volts",
@@ -173,15 +172,12 @@ impl Request for CalibrateRequest {
             ),
             _ => Ok(()),
         }
-    }
-    fn name(&self) -> &'static str {
-        "calibrate"
-    }
-    /// Per mode two fits of four parameters over at most the whole spectrum; the columns, the
-    /// fitted curve, the layouts' copies and the document's numbers (200 bytes a row).
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        let rows = self.rows() as f64;
-        let modes = self.peaks.unwrap_or(model.params.modes) as f64;
+    };
+    // Per mode two fits of four parameters over at most the whole spectrum; the columns, the
+    // fitted curve, the layouts' copies and the document's numbers (200 bytes a row).
+    cost |r, model| {
+        let rows = r.rows() as f64;
+        let modes = r.peaks.unwrap_or(model.params.modes) as f64;
         let fits = 2.0 * super::fit_dynamic::fit_evaluations(4, None);
         Ok(Cost {
             bytes: MODEL_BYTES + rows * 200.0,

@@ -380,13 +380,7 @@ impl ChartRequest {
             ));
         }
         in_range("tile", self.tile, 1..=MAX_CHART_TILE)?;
-        if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
-            return Err(SimError::out_of_range(
-                "cluster_tol",
-                self.cluster_tol,
-                "must be finite and > 0",
-            ));
-        }
+        super::limits::positive("cluster_tol", self.cluster_tol, "must be finite and > 0")?;
         if self.lyapunov_periods > MAX_CHART_LYAPUNOV_PERIODS
             || (1..10).contains(&self.lyapunov_periods)
         {

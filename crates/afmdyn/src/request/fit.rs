@@ -8,7 +8,7 @@ use super::costs::OPERATION_WORK;
 use super::fit_dynamic::fit_evaluations;
 use super::fit_result::MIN_FIT_ROWS;
 use super::limits::Cost;
-use super::run::{Request, Resolved};
+use super::run::Resolved;
 use crate::analysis::fit::force_curve::{self, Segment, CONTACT_POINT, YOUNGS_MODULUS};
 use crate::analysis::fit::profile::MAX_GRID_REFITS;
 use crate::analysis::fit::sls_curve;
@@ -482,21 +482,25 @@ impl FitRequest {
     }
 }
 
-impl Request for FitRequest {
-    const COST_ADVICE: &'static str =
-        "give fewer rows (an AM curve: fit fewer rows or parameters, or without profiles)";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        if super::fit_dynamic::read_am_data(self.data.as_deref())?.is_some() {
+impl_request! {
+    // a force curve uses the probe's spring constant, tip and sample only; an AM, FM or
+    // bimodal curve refuses the values a quasi-static read stood in for
+    // (`super::fit_dynamic::am_probe`)
+    FitRequest, "fit",
+    advice = "give fewer rows (an AM curve: fit fewer rows or parameters, or without profiles)",
+    needs = Static;
+    validate |r, model| {
+        if super::fit_dynamic::read_am_data(r.data.as_deref())?.is_some() {
             // an AM curve: its names and columns are checked when it runs; a probe read
             // for a force curve (its stand-ins) is refused now
             if let Some(p) = model.probe.as_ref().filter(|p| !p.assumed.is_empty()) {
                 super::fit_dynamic::am_probe(p)?;
             }
-            if let Some((name, value)) = self
+            if let Some((name, value)) = r
                 .thickness
                 .map(|h| ("thickness", crate::error::number(h)))
-                .or(self.bonded.map(|b| ("bonded", b.to_string())))
-                .or(self
+                .or(r.bonded.map(|b| ("bonded", b.to_string())))
+                .or(r
                     .temperature
                     .map(|t| ("temperature", crate::error::number(t))))
             {
@@ -508,40 +512,31 @@ impl Request for FitRequest {
                         .into(),
                 ));
             }
-            return self.check_range();
+            return r.check_range();
         }
-        self.check(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "fit"
-    }
-    /// A force curve uses the probe's spring constant, tip and sample only; an AM, FM or
-    /// bimodal curve refuses the values a quasi-static read stood in for
-    /// (`super::fit_dynamic::am_probe`).
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Static
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        r.check(model).map(|_| ())
+    };
+    cost |r, model| {
         // an AM curve: its stepped approaches, the profiles' refits included
-        if let Some(d) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
+        if let Some(d) = super::fit_dynamic::read_am_data(r.data.as_deref())? {
             let law = model
                 .probe
                 .as_ref()
                 .map_or("", |p| p.params.contact_law.name());
-            let default_fit = self.fit == FitRequest::default().fit;
-            let n = super::fit_dynamic::fitted_names(&self.fit, default_fit, law).len();
-            let profiles = self.profiles.unwrap_or(false);
+            let default_fit = r.fit == FitRequest::default().fit;
+            let n = super::fit_dynamic::fitted_names(&r.fit, default_fit, law).len();
+            let profiles = r.profiles.unwrap_or(false);
             return super::fit_dynamic::cost(d.z.len(), n, profiles, &model.params);
         }
         // no integration; a row of the columns, the preprocessed curve, the Jacobian (≤ 5
         // columns), the residuals, the document's numbers, the outcome's arrays and the front
         // end's table and figures: 900 bytes (the library's run 343 at 1 000 to 10⁶ rows,
         // `tests/door.rs`; the command line's heap 783 and its resident set 818 at 10⁶ rows)
-        let (n, walk) = (self.fit.len().max(5), self.profiles.unwrap_or(true));
-        let rows = if self.data.is_some() {
+        let (n, walk) = (r.fit.len().max(5), r.profiles.unwrap_or(true));
+        let rows = if r.data.is_some() {
             MAX_FIT_ROWS
         } else {
-            self.force.len()
+            r.force.len()
         } as f64;
         Ok(Cost {
             bytes: super::costs::MODEL_BYTES + rows * 900.0,

@@ -8,7 +8,6 @@ use super::costs::OPERATION_WORK;
 use super::fit::{bad, FitRequest, FitSegment};
 use super::fit_dynamic::fit_evaluations;
 use super::limits::Cost;
-use super::run::{Request, Resolved};
 use crate::analysis::fit::force_curve::{BASELINE, CONTACT_POINT, YOUNGS_MODULUS};
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -143,33 +142,28 @@ impl FitMapRequest {
     }
 }
 
-impl Request for FitMapRequest {
-    const COST_ADVICE: &'static str = "fit a part of the map, or curves of fewer rows";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.path()?;
-        super::limits::check_threads(self.threads)?;
-        self.check_layer()?;
-        self.curve_request().check(model).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "fit_map"
-    }
-    /// A map's curves use the probe's spring constant (where the map has none), tip and
-    /// sample only.
-    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
-        crate::probe::ProbeNeeds::Static
-    }
-    /// Measured on the map's index: each curve's record and index entry, one curve under way
-    /// per worker thread, and each row's evaluations.
-    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+impl_request! {
+    // a map's curves use the probe's spring constant (where the map has none), tip and
+    // sample only
+    FitMapRequest, "fit_map", advice = "fit a part of the map, or curves of fewer rows",
+    needs = Static;
+    validate |r, model| {
+        r.path()?;
+        super::limits::check_threads(r.threads)?;
+        r.check_layer()?;
+        r.curve_request().check(model).map(|_| ())
+    };
+    // Measured on the map's index: each curve's record and index entry, one curve under way
+    // per worker thread, and each row's evaluations.
+    cost |r, _| {
         let (curves, rows, longest) = {
-            let map = self.index()?;
+            let map = r.index()?;
             let rows: usize = map.curves.iter().map(|c| c.rows).sum();
             (map.curves.len() as f64, rows as f64, map.max_rows() as f64)
         };
         let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
-        let threads = self.threads.unwrap_or_else(cores) as f64;
-        let n = self.fit.len().max(1);
+        let threads = r.threads.unwrap_or_else(cores) as f64;
+        let n = r.fit.len().max(1);
         Ok(Cost {
             bytes: super::costs::MODEL_BYTES + curves * CURVE_BYTES + threads * longest * ROW_BYTES,
             work: rows * OPERATION_WORK * fit_evaluations(n, None),

@@ -33,14 +33,12 @@ pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Resul
              (modulation_frequency, modulation_amplitude)",
         ));
     }
-    if !(setpoint.is_finite() && setpoint > 0.0) {
-        return Err(SimError::out_of_range(
-            "setpoint",
-            setpoint,
-            "must be the peak force (N) the feedback holds, finite and > 0 (2 nN is 2e-9, or \
-             2nN on the command line)",
-        ));
-    }
+    super::limits::positive(
+        "setpoint",
+        setpoint,
+        "must be the peak force (N) the feedback holds, finite and > 0 (2 nN is 2e-9, or 2nN \
+         on the command line)",
+    )?;
     Ok(background)
 }
 

@@ -41,6 +41,17 @@ pub(crate) fn check_threads(threads: Option<usize>) -> Result<(), crate::SimErro
         crate::error::in_range("threads", t, 1..=MAX_THREADS)
     })
 }
+
+/// `value` finite and > 0, else [`crate::SimError::OutOfRange`] naming `name` and `allowed`.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    allowed: &'static str,
+) -> Result<(), crate::SimError> {
+    use std::ops::Bound::Excluded;
+    let open = (Excluded(0.0), Excluded(f64::INFINITY));
+    crate::error::within(name, value, open, allowed)
+}
 /// What a request costs ([`crate::request::Request::cost`]), estimated before it runs for the
 /// worst case its options allow (`crate::request::costs`).
 #[derive(Debug, Clone, Copy, PartialEq)]

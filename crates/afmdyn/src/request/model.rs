@@ -595,13 +595,7 @@ fn omega_of_drive_frequency(f: f64, probe: Option<&Probe>) -> Result<f64, SimErr
             "needs a probe file (drive_frequency is in Hz, SI)",
         )
     })?;
-    if !(f.is_finite() && f > 0.0) {
-        return Err(SimError::out_of_range(
-            "drive_frequency",
-            f,
-            "must be finite and > 0 (Hz)",
-        ));
-    }
+    super::limits::positive("drive_frequency", f, "must be finite and > 0 (Hz)")?;
     let (lo, hi) = super::limits::SI_FREQUENCY_RATIO;
     let ratio = f / probe.drive_frequency;
     if !(lo..=hi).contains(&ratio) {

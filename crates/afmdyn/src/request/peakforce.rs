@@ -162,16 +162,12 @@ impl PeakForceRequest {
                 }
                 q = p.with(SweepParam::Alpha5, p.alpha5_for_rest_distance(z / length));
             }
-            (None, Some(f)) => {
-                if !(f.is_finite() && f > 0.0) {
-                    return Err(SimError::out_of_range(
-                        "setpoint",
-                        f,
-                        "must be a finite peak force > 0 (N with a probe: 2 nN is 2e-9, or \
-                         2nN on the command line)",
-                    ));
-                }
-            }
+            (None, Some(f)) => super::limits::positive(
+                "setpoint",
+                f,
+                "must be a finite peak force > 0 (N with a probe: 2 nN is 2e-9, or 2nN on the \
+                 command line)",
+            )?,
             (None, None) => {}
         }
         q.validate()?;

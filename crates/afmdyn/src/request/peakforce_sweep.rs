@@ -79,13 +79,7 @@ impl PeakForceSweep {
         crate::error::finite("from", from)?;
         crate::error::finite("to", to)?;
         let step = step.abs();
-        if !(step.is_finite() && step > 0.0) {
-            return Err(SimError::out_of_range(
-                "step",
-                step,
-                "must be finite and ≠ 0",
-            ));
-        }
+        super::limits::positive("step", step, "must be finite and ≠ 0")?;
         // one part in 1e9 of a step forgiven: 0.1 steps of 1.0 give 11 values
         let n = ((to - from).abs() / step * (1.0 + 1e-9)).floor();
         if n + 1.0 > MAX_SWEEP_POINTS as f64 {

@@ -145,9 +145,7 @@ impl ReconstructRequest {
     pub fn curve(&self) -> Result<ShiftCurve, SimError> {
         // the constants first: a wrong unit would otherwise show as distances out of order
         for ((name, section, key), v) in CONSTANTS.iter().zip(self.constants()) {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SimError::out_of_range(name, v, "must be finite and > 0"));
-            }
+            super::limits::positive(name, v, "must be finite and > 0")?;
             if let Some(why) = range_of(section, key).refusal(v) {
                 return Err(SimError::out_of_range(name, v, why));
             }

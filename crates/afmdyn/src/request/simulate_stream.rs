@@ -5,7 +5,6 @@
 use super::analyses::{initial_state, SeriesStore, SimulateRequest, SimulateSpan};
 use super::costs::{state_bytes, MODEL_BYTES};
 use super::limits::Cost;
-use super::run::{Request, Resolved};
 use crate::analysis::spectrum::SPECTRUM_SAMPLES;
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -59,34 +58,32 @@ impl SimulateStream {
     }
 }
 
-impl Request for SimulateStream {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.span(&model.params)?;
-        self.request.integrator_options()?;
-        self.request.thermal(model.probe.as_ref())?;
+impl_request! {
+    SimulateStream, "simulate";
+    validate |r, model| {
+        r.span(&model.params)?;
+        r.request.integrator_options()?;
+        r.request.thermal(model.probe.as_ref())?;
         let m = CantileverModel::new(&model.params)?;
-        initial_state(&m, self.request.initial.as_deref()).map(|_| ())
-    }
-    fn name(&self) -> &'static str {
-        "simulate"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        initial_state(&m, r.request.initial.as_deref()).map(|_| ())
+    };
+    cost |r, model| {
         // every period integrated, transient included; in memory one chunk of samples (its
         // rows and the converted copy, at most CHUNK_SAMPLES of 6 + 2N + m values, or one
         // period of them) and the plots' windows (the last TIP_WINDOW_PERIODS periods, the
         // phase portrait's and the spectrum's samples, the decimated lines)
         let p = &model.params;
-        let span = self.span(p)?;
-        let spp = self.request.samples_per_period as f64;
+        let span = r.span(p)?;
+        let spp = r.request.samples_per_period as f64;
         let row = 6.0 * 8.0 + state_bytes(p);
-        let chunk = match self.chunk_periods {
+        let chunk = match r.chunk_periods {
             Some(n) => n as f64 * spp,
             None => (CHUNK_SAMPLES as f64).max(spp),
         };
         let plots = (TIP_WINDOW_PERIODS as f64 * spp + 1.0) * 32.0
             + PHASE_SAMPLES as f64 * 24.0
             + 2.0 * 9.0 * TIP_COLUMNS * 16.0;
-        let kept = match self.dir {
+        let kept = match r.dir {
             Some(_) => 2.0 * chunk * row + SPECTRUM_SAMPLES as f64 * 8.0 + plots,
             None => 0.0,
         };

@@ -4,7 +4,7 @@
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::limits::Cost;
-use super::run::{Request, Resolved};
+use super::run::Resolved;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
 
@@ -131,34 +131,31 @@ fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimEr
     SimError::out_of_range(name, value.to_string(), allowed)
 }
 
-impl Request for ThermalRequest {
-    const COST_ADVICE: &'static str = "ask for fewer points";
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        check_thermal(model, self.temperature(), self.spot())?;
-        if let Some(f) = self.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
+impl_request! {
+    ThermalRequest, "thermal", advice = "ask for fewer points";
+    validate |r, model| {
+        check_thermal(model, r.temperature(), r.spot())?;
+        if let Some(f) = r.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
             return Err(bad(
                 "to",
                 crate::error::number(f),
                 "the highest frequency must be finite and > 0 (Hz)",
             ));
         }
-        if !(1..=MAX_POINTS).contains(&self.points()) {
+        if !(1..=MAX_POINTS).contains(&r.points()) {
             return Err(bad(
                 "points",
-                self.points(),
+                r.points(),
                 "the number of frequencies must be 1..=10000000",
             ));
         }
         Ok(())
-    }
-    fn name(&self) -> &'static str {
-        "thermal"
-    }
-    /// An N × N complex factorisation per frequency; the spectrum's columns, their copies in
-    /// the layouts and the document's JSON values (256 bytes a frequency).
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+    };
+    // An N × N complex factorisation per frequency; the spectrum's columns, their copies in
+    // the layouts and the document's JSON values (256 bytes a frequency).
+    cost |r, model| {
         let n = model.params.modes as f64;
-        let points = self.points() as f64;
+        let points = r.points() as f64;
         Ok(Cost {
             bytes: MODEL_BYTES + points * 256.0,
             work: points * OPERATION_WORK * (n * n * n + 4.0 * n * n),
