@@ -735,6 +735,10 @@ def layout_pages() -> Dict[str, str]:
 # --- csv-files.md ----------------------------------------------------------------------------
 
 P = "examples/probe-point-mass-dmt.toml"
+#: simulate's run (every file it writes: the series as CSV, the energy balance audited)
+SIM = ["simulate", "--periods", "2", "--csv", "--energy-balance", "--files", "data"]
+#: PeakForce's run (its force curve and one cycle)
+PF = ["peakforce", "--probe", "examples/probe-peakforce-air.toml"]
 #: the small runs whose CSV files the page lists: (the file, the command's arguments, the
 #: analysis whose layout (docs/schema/layouts) names the columns); a file written by two runs is
 #: listed under its name and the second run's last flag
@@ -756,6 +760,23 @@ CSV_RUNS = [
     # (an attractor's file is a trajectory: the variables of simulate's layout)
     ("attractor-1.csv", ["attractors", "--omega", "2.6", "--samples", "8"], "simulate"),
     ("converge.csv", ["converge"], "converge"),
+    ("timeseries.csv", SIM, "simulate"),
+    ("events.csv", SIM, "simulate"),
+    ("poincare.csv", SIM, "simulate"),
+    ("energy.csv", SIM, "simulate"),
+    ("spectrum.csv", SIM, "simulate"),
+    ("bifurcation.csv", ["bifurcation", "--steps", "2", "--threads", "1"], "bifurcation"),
+    ("basins.csv", ["basins", "--x-steps", "2", "--y-steps", "2", "--threads", "1"], "basins"),
+    ("continuation.csv", ["continue", "--from", "3", "--to", "2.9"], "continuation"),
+    ("attractors-sweep.csv", ["attractors", "--sweep", "omega", "--from", "2.6", "--to", "2.7",
+                              "--steps", "2", "--samples", "4"], "global_continuation"),
+    ("fig3.csv", ["modes", "--sweep", "fig3"], "modes"),
+    ("peakforce-curve.csv", PF, "peakforce"),
+    ("peakforce-cycle.csv", PF, "peakforce"),
+    ("fit-curve.csv", ["fit", "--probe", "examples/probe-fit-hertz.toml", "--data",
+                       "examples/force-curve-hertz.csv"], "fit"),
+    ("fit_map.csv", ["fit-map", "--probe", "examples/probe-fit-hertz.toml", "--data",
+                     "examples/force-map-hertz.csv"], "fit_map"),
 ]
 
 
@@ -807,6 +828,11 @@ def csv_page() -> str:
     for name, args, analysis in CSV_RUNS:
         label = csv_label(name, args)
         entry = snapshot[label]
+        stale = [d["name"] for d in declared.get(name, [])
+                 if "{N}" not in d["name"] and d["name"] not in entry["columns"]]
+        if stale:
+            raise SystemExit(f"docs/schema/csv-columns.json declares {stale} for {name}, whose "
+                             f"header (the snapshot) has no such column")
         npy = {c["name"]: c for c in entry.get("npy", [])}
         npy.update({c["name"]: c for c in declared.get(name, [])})
         # a declared name with `{N}` stands for the names with a number there

@@ -398,8 +398,9 @@ fn probe_keys_match_the_committed_file() {
 
 /// The columns the library declares for a CSV file that has no `.npy.json` beside it
 /// (`docs/schema/csv-columns.json`, which `scripts/gen_reference.py` shows in the book's CSV
-/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]) and `converge.csv`'s
-/// (`{N}` in a name stands for a number).
+/// files): `chart.csv`'s ([`afmdyn::request::chart::CSV_COLUMNS`]), `converge.csv`'s (`{N}` in
+/// a name stands for a number), `bifurcation.csv`'s (the sweep's records) and the other
+/// commands' (`afmdyn::report::csv_columns`).
 #[test]
 fn csv_columns_match_the_committed_file() {
     let columns = |c: &[(&str, &str, &str)]| -> Vec<Value> {
@@ -407,11 +408,25 @@ fn csv_columns_match_the_committed_file() {
             .map(|(name, unit, meaning)| serde_json::json!({"name": name, "unit": unit, "meaning": meaning}))
             .collect()
     };
-    let chart = columns(&afmdyn::request::chart::CSV_COLUMNS);
-    let converge = columns(&afmdyn::report::present::converge::COLUMNS);
+    use afmdyn::report::csv_columns as c;
+    let sweep: Vec<(&str, &str, &str)> = (afmdyn::report::sweep::COLUMNS.iter())
+        .map(|r| (r.name, r.unit, r.meaning))
+        .collect();
     committed(
         "csv-columns.json",
-        &serde_json::json!({"chart.csv": chart, "converge.csv": converge}),
+        &serde_json::json!({
+            "chart.csv": columns(&afmdyn::request::chart::CSV_COLUMNS),
+            "converge.csv": columns(&afmdyn::report::present::converge::COLUMNS),
+            "bifurcation.csv": columns(&sweep),
+            "events.csv": columns(&c::EVENTS),
+            "energy.csv": columns(&c::ENERGY),
+            "spectrum.csv": columns(&c::SPECTRUM),
+            "basins.csv": columns(&c::BASINS),
+            "attractors-sweep.csv": columns(&c::ATTRACTORS_SWEEP),
+            "continuation.csv": columns(&c::CONTINUATION),
+            "fig3.csv": columns(&c::FIG3),
+            "fit_map.csv": columns(&c::FIT_MAP),
+        }),
     );
 }
 

@@ -390,6 +390,7 @@ pub(crate) mod basins;
 mod branches;
 pub(crate) mod chart_layout;
 mod convergence;
+pub mod csv_columns;
 pub(crate) mod curve_layout;
 #[cfg(feature = "files")]
 mod curve_table;

@@ -111,12 +111,7 @@ pub(crate) fn fig3(modes: usize, pts: &[crate::eigen::Fig3Point]) -> Presentatio
     let mut s = Presentation::default();
     s.csv(
         "fig3.csv",
-        &[
-            "alpha1",
-            "alpha4",
-            "omega1_over_omega01",
-            "omega2_over_omega02",
-        ],
+        &crate::report::csv_columns::FIG3.map(|c| c.0),
         pts.iter()
             .map(|q| vec![f(q.alpha1), f(q.alpha4), f(q.ratio1), f(q.ratio2)])
             .collect(),
