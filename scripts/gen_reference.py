@@ -805,70 +805,94 @@ def csv_label(name: str, args: List[str]) -> str:
     return name if args == first else f"{name} {args[-1]}"
 
 
-def csv_page() -> str:
+#: the commands whose CSV files are on the AFM page (the others on the dynamics page)
+CSV_AFM = ("approach", "resonance", "bimodal", "fm", "reconstruct", "peakforce", "fit", "fit-map")
+
+
+def csv_pages() -> Dict[str, str]:
+    """``csv-files.md`` (the files and their pages) and its two pages, ``csv-files/afm.md`` (the
+    AFM commands' files) and ``csv-files/dynamics.md`` (the nonlinear-dynamics commands')."""
     snapshot = json.loads(CSV_SNAPSHOT.read_text())
     declared = json.loads(CSV_COLUMNS.read_text())
     files = layouts()
-    out = [header("docs/reference/csv-files.snapshot.json, the columns of the files of "
-                  "small runs of the binary (crates/afmdyn-py/tests/test_reference.py compares "
-                  "it with the binary), and the units and meanings the library declares for "
-                  "them: the `.npy.json` of a table written with one, the file's columns in "
-                  "docs/schema/csv-columns.json, else the variable of the same name in the "
-                  "analysis's layout"),
-           "# CSV files", "",
-           "The columns of each CSV file of the command line, as a small run of each command "
-           "writes them, with their unit and meaning as the library declares them: from the "
-           "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
-           "one, or the library's table of the file's columns (`chart.csv`, `converge.csv`; "
-           "docs/schema/csv-columns.json), else from the variable of the same name in the analysis's "
-           "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
-           "without a probe, and under one where that differs). A column the library declares "
-           "neither way has no unit or meaning here: "
-           "the page of the command's outputs says what it holds.", ""]
+    source = header("docs/reference/csv-files.snapshot.json, the columns of the files of "
+                    "small runs of the binary (crates/afmdyn-py/tests/test_reference.py compares "
+                    "it with the binary), and the units and meanings the library declares for "
+                    "them: the `.npy.json` of a table written with one, the file's columns in "
+                    "docs/schema/csv-columns.json, else the variable of the same name in the "
+                    "analysis's layout")
+    index = [source, "# CSV files", "",
+             "The columns of each CSV file of the command line, as a small run of each command "
+             "writes them, with their unit and meaning as the library declares them: from the "
+             "file's `.npy.json` (the same numeric columns as `.npy`) where the command writes "
+             "one, or the library's table of the file's columns (docs/schema/csv-columns.json), "
+             "else from the variable of the same name in the analysis's "
+             "[result layout](layouts.md) (an attractor's trajectory: `simulate`'s; its unit "
+             "without a probe, and under one where that differs). A column the library declares "
+             "neither way has no unit or meaning here: "
+             "the page of the command's outputs says what it holds.", "",
+             "```{toctree}", ":hidden:", "", "csv-files/afm", "csv-files/dynamics", "```", "",
+             "| File | Command |", "|---|---|"]
+    pages = {"afm": [source, "# CSV files of the AFM commands", ""],
+             "dynamics": [source, "# CSV files of the nonlinear-dynamics commands", ""]}
     for name, args, analysis in CSV_RUNS:
+        page = "afm" if args[0] in CSV_AFM else "dynamics"
         label = csv_label(name, args)
-        entry = snapshot[label]
-        stale = [d["name"] for d in declared.get(name, [])
-                 if "{N}" not in d["name"] and d["name"] not in entry["columns"]]
-        if stale:
-            raise SystemExit(f"docs/schema/csv-columns.json declares {stale} for {name}, whose "
-                             f"header (the snapshot) has no such column")
-        npy = {c["name"]: c for c in entry.get("npy", [])}
-        npy.update({c["name"]: c for c in declared.get(name, [])})
-        # a declared name with `{N}` stands for the names with a number there
-        for c in list(entry["columns"]):
-            for d in declared.get(name, []):
-                pattern = re.escape(d["name"]).replace(r"\{N\}", r"(\d+)")
-                m = re.fullmatch(pattern, c) if "{N}" in d["name"] else None
-                if m:
-                    npy[c] = {"unit": d["unit"],
-                              "meaning": re.sub(r"\bN\b", m.group(1), d["meaning"])}
-        variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
-        for variant, data in reversed(files.get(analysis, [])):
-            # (an attractor's trajectory is in the model's units: not simulate's under a probe)
-            if variant not in (None, "si") or (variant == "si" and analysis != args[0]):
-                continue
-            for ds in data["datasets"]:
-                for v in ds["variables"]:
-                    base, si = variables.get(v["name"], (v, None))
-                    variables[v["name"]] = (base, v) if variant == "si" else (v, si)
-        out += [f"## `{label}`", "", f"Written by `{entry['command']}`"
-                + (" (units as in this run: SI under its probe)." if entry.get("npy") else "."), "",
-                "| Column | Unit | Meaning |", "|---|---|---|"]
-        for c in entry["columns"]:
-            if c in npy:
-                unit, what = npy[c]["unit"], npy[c]["meaning"]
-            elif c in variables:
-                base, si = variables[c]
-                unit = base["units"] or "1"
-                if si is not None and si["units"] != base["units"]:
-                    unit += f" ({si['units']} under a probe)"
-                what = meaning(base)
-            else:
-                unit, what = "", ""
-            out.append(f"| `{c}` | {cell(unit) or '–'} | {cell(what)} |")
-        out.append("")
-    return "\n".join(out).rstrip("\n") + "\n"
+        anchor = re.sub(r"[^a-z0-9_ -]", "", label.lower()).replace(" ", "-")
+        index.append(f"| [`{label}`](csv-files/{page}.md#{anchor}) | `afmdyn {args[0]}` |")
+        pages[page] += csv_section(name, args, analysis, snapshot, declared, files)
+    out = {f"csv-files/{p}.md": "\n".join(t).rstrip("\n") + "\n" for p, t in pages.items()}
+    out["csv-files.md"] = "\n".join(index) + "\n"
+    return out
+
+
+def csv_section(name: str, args: List[str], analysis: str, snapshot: dict, declared: dict,
+                files: dict) -> List[str]:
+    """The section of one file of ``CSV_RUNS``: its command and its columns' table."""
+    out: List[str] = []
+    label = csv_label(name, args)
+    entry = snapshot[label]
+    stale = [d["name"] for d in declared.get(name, [])
+             if "{N}" not in d["name"] and d["name"] not in entry["columns"]]
+    if stale:
+        raise SystemExit(f"docs/schema/csv-columns.json declares {stale} for {name}, whose "
+                         f"header (the snapshot) has no such column")
+    npy = {c["name"]: c for c in entry.get("npy", [])}
+    npy.update({c["name"]: c for c in declared.get(name, [])})
+    # a declared name with `{N}` stands for the names with a number there
+    for c in list(entry["columns"]):
+        for d in declared.get(name, []):
+            pattern = re.escape(d["name"]).replace(r"\{N\}", r"(\d+)")
+            m = re.fullmatch(pattern, c) if "{N}" in d["name"] else None
+            if m:
+                npy[c] = {"unit": d["unit"],
+                          "meaning": re.sub(r"\bN\b", m.group(1), d["meaning"])}
+    variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
+    for variant, data in reversed(files.get(analysis, [])):
+        # (an attractor's trajectory is in the model's units: not simulate's under a probe)
+        if variant not in (None, "si") or (variant == "si" and analysis != args[0]):
+            continue
+        for ds in data["datasets"]:
+            for v in ds["variables"]:
+                base, si = variables.get(v["name"], (v, None))
+                variables[v["name"]] = (base, v) if variant == "si" else (v, si)
+    out += [f"## `{label}`", "", f"Written by `{entry['command']}`"
+            + (" (units as in this run: SI under its probe)." if entry.get("npy") else "."), "",
+            "| Column | Unit | Meaning |", "|---|---|---|"]
+    for c in entry["columns"]:
+        if c in npy:
+            unit, what = npy[c]["unit"], npy[c]["meaning"]
+        elif c in variables:
+            base, si = variables[c]
+            unit = base["units"] or "1"
+            if si is not None and si["units"] != base["units"]:
+                unit += f" ({si['units']} under a probe)"
+            what = meaning(base)
+        else:
+            unit, what = "", ""
+        out.append(f"| `{c}` | {cell(unit) or '–'} | {cell(what)} |")
+    out.append("")
+    return out
 
 
 # --- index.md and main ---------------------------------------------------------------------
@@ -880,7 +904,7 @@ PAGES: Dict[str, Callable[[], str]] = {
     "python": python_page,
     "messages": messages_page,
     "layouts": lambda: "",
-    "csv-files": csv_page,
+    "csv-files": lambda: "",
 }
 
 
@@ -904,9 +928,10 @@ def visible(page: str) -> str:
 def generate() -> Dict[Path, str]:
     """The text of every generated page."""
     out = {REF / f"{name}.md": make() for name, make in PAGES.items()
-           if name not in ("commands", "layouts")}
+           if name not in ("commands", "layouts", "csv-files")}
     out.update({REF / p: t for p, t in commands_pages(HELP.read_text()).items()})
     out.update({REF / p: t for p, t in layout_pages().items()})
+    out.update({REF / p: t for p, t in csv_pages().items()})
     out[REF / "index.md"] = index_page()
     return {p: visible(t) for p, t in out.items()}
 
