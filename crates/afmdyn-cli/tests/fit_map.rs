@@ -124,3 +124,25 @@ fn a_malformed_map_exits_2_with_one_line() {
         "{err}"
     );
 }
+
+/// An instrument's binary map given to the command line (which reads CSV or the NetCDF of
+/// `afmdyn.export_map`) is refused in one readable line that says which files it reads, not
+/// the CSV reader's internal error.
+#[test]
+fn a_binary_map_is_refused_saying_what_the_command_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let jpk = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/fmt-jpk-fd_map2x2_extracted.jpk-force-map"
+    );
+    let out = fit_map(jpk, &dir.path().join("out"), &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("not a CSV map")
+            && err.contains("afmdyn.export_map")
+            && !err.contains("Utf8 {"),
+        "{err}"
+    );
+}

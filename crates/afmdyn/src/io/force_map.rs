@@ -363,9 +363,20 @@ fn number(
 fn csv_index(path: &Path) -> Result<(CsvColumns, Vec<MapCurve>), InputFileError> {
     let file = open(path, InputKind::ForceMap)?;
     let mut rdr = csv::ReaderBuilder::new().flexible(true).from_reader(file);
-    let io = |e: csv::Error| match e.into_kind() {
-        csv::ErrorKind::Io(e) => failure(path, &e),
-        other => invalid(path, format!("{other:?}")),
+    let io = |e: csv::Error| {
+        let text = e.to_string();
+        match e.into_kind() {
+            csv::ErrorKind::Io(e) => failure(path, &e),
+            csv::ErrorKind::Utf8 { .. } => invalid(
+                path,
+                format!(
+                    "not a CSV map ({text}): the command line reads a long-format CSV (x, y, \
+                     height, force) or the NetCDF file afmdyn.export_map writes from an \
+                     instrument's map (JPK and the others afmformats reads)"
+                ),
+            ),
+            _ => invalid(path, text),
+        }
     };
     let names = rdr.headers().map_err(io)?.clone();
     let columns = CsvColumns {
