@@ -3,6 +3,7 @@
 //! `Params::validate`, the requests' checks, the readers and the cost budget test against),
 //! and must equal the committed text, so that the book cannot drift from the code.
 //! `AFMDYN_WRITE_SCHEMA=1 cargo test -p afmdyn --lib integration::limits_table::` rewrites it.
+#![cfg(feature = "files")]
 
 use afmdyn::analysis::attractors::MAX_ATTRACTOR_SAMPLES;
 use afmdyn::analysis::bifurcation::MAX_SWEEP_POINTS;
