@@ -800,13 +800,15 @@ fn contact_force_sign_in_data_matches_its_documentation() {
     let meaning = meta["columns"][5]["meaning"].as_str().unwrap();
     assert!(meaning.contains(afmdyn::contact::FORCE_SIGN), "{meaning}");
     assert!(afmdyn::contact::FORCE_SIGN.starts_with("positive when the sample pushes the tip away"));
-    let doc = include_str!("../../../docs/outputs.md");
-    let row = doc
-        .lines()
+    // the outputs page states the sign; the CSV page's row is the layout's meaning
+    let doc = include_str!("../../../docs/outputs.md").replace('\n', " ");
+    assert!(doc.contains("F_c > 0 pushes the tip away"));
+    assert!(!doc.contains("F_c < 0 pushes"));
+    let csv = include_str!("../../../docs/reference/csv-files/dynamics.md");
+    let row = (csv.lines())
         .find(|l| l.starts_with("| `contact_force` |"))
         .unwrap();
-    assert!(row.contains("F_c > 0 pushes the tip away"), "{row}");
-    assert!(!row.contains("F_c < 0 pushes"), "{row}");
+    assert!(row.contains(afmdyn::contact::FORCE_SIGN), "{row}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -2,7 +2,7 @@
 scripts/gen_reference.py from docs/reference/commands.help.txt, a snapshot of the binary's help
 (so that CI's ``python3 scripts/gen_stubs.py --check`` needs no build); this test keeps the
 snapshot true: it is the help of the checkout's ``afmdyn``, byte for byte. Likewise
-docs/reference/csv-files.md's columns, from docs/reference/csv-files.snapshot.json."""
+the CSV pages' columns (docs/reference/csv-files/*.md), from docs/reference/csv-files.snapshot.json."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def test_the_help_snapshot_is_the_binarys_help(cli) -> None:
 
 
 def test_the_csv_snapshot_is_what_the_binary_writes(cli) -> None:
-    """docs/reference/csv-files.md lists each CSV file's columns from a snapshot of small runs;
+    """docs/reference/csv-files/*.md list each CSV file's columns from a snapshot of small runs;
     the checkout's binary writes the same columns."""
     def run(args):
         out = cli(*args, cwd=gen_reference.ROOT)
