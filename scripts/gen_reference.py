@@ -740,7 +740,8 @@ SIM = ["simulate", "--periods", "2", "--csv", "--energy-balance", "--files", "da
 #: PeakForce's run (its force curve and one cycle)
 PF = ["peakforce", "--probe", "examples/probe-peakforce-air.toml"]
 #: the small runs whose CSV files the page lists: (the file, the command's arguments, the
-#: analysis whose layout (docs/schema/layouts) names the columns); a file written by two runs is
+#: analysis whose layout (docs/schema/layouts) names the columns, `analysis.variant` for a
+#: variant's layout); a file written by two runs is
 #: listed under its name and the second run's last flag
 CSV_RUNS = [
     ("approach.csv", ["approach", "--probe", P, "--points", "5", "--files", "data"], "approach"),
@@ -773,6 +774,8 @@ CSV_RUNS = [
     ("fig3.csv", ["modes", "--sweep", "fig3"], "modes"),
     ("peakforce-curve.csv", PF, "peakforce"),
     ("peakforce-cycle.csv", PF, "peakforce"),
+    ("peakforce-sweep.csv", [*PF, "--sweep", "z_c", "--from", "10nm", "--to", "9nm", "--step",
+                             "1nm"], "peakforce.sweep"),
     ("fit-curve.csv", ["fit", "--probe", "examples/probe-fit-hertz.toml", "--data",
                        "examples/force-curve-hertz.csv"], "fit"),
     ("fit_map.csv", ["fit-map", "--probe", "examples/probe-fit-hertz.toml", "--data",
@@ -868,9 +871,12 @@ def csv_section(name: str, args: List[str], analysis: str, snapshot: dict, decla
                 npy[c] = {"unit": d["unit"],
                           "meaning": re.sub(r"\bN\b", m.group(1), d["meaning"])}
     variables: Dict[str, Tuple[dict, Optional[dict]]] = {}
+    # `analysis.variant` (`peakforce.sweep`): that variant's layout besides the base one's
+    analysis, _, own = analysis.partition(".")
     for variant, data in reversed(files.get(analysis, [])):
         # (an attractor's trajectory is in the model's units: not simulate's under a probe)
-        if variant not in (None, "si") or (variant == "si" and analysis != args[0]):
+        if variant not in (None, "si", own or None) or (
+                variant == "si" and analysis != args[0]):
             continue
         for ds in data["datasets"]:
             for v in ds["variables"]:
