@@ -203,7 +203,7 @@ fn the_kept_factorisation_is_nalgebras_solve() {
 
 /// The oscillator's share below r: the whole of it far above the peak (1 − 2/(3πQr³) to
 /// leading order), 2r/(πQ) far below, and half of it at r = 1 for a sharp peak; for Q from 0.5
-/// (overdamped) to 10⁵.
+/// (overdamped) to 10⁵; a sharp peak's tail against its closed form.
 #[test]
 fn the_band_fraction_is_the_oscillators() {
     for q in [0.5, 2.0, 400.0, 1e5] {
@@ -218,4 +218,11 @@ fn the_band_fraction_is_the_oscillators() {
     }
     assert!((band_fraction(Some(1e5), 1.0) - 0.5).abs() < 1e-4);
     assert_eq!(band_fraction(None, 1.0), band_fraction(Some(0.5), 1.0));
+    // a sharp peak's tail above r = 1.5 is ∫ dx/(x² − 1)² = r/(2(r² − 1)) − ln((r + 1)/(r − 1))/4
+    // to a relative 1/Q² (the damping term dropped)
+    let (q, r) = (1e5, 1.5_f64);
+    let tail = r / (2.0 * (r * r - 1.0)) - ((r + 1.0) / (r - 1.0)).ln() / 4.0;
+    let want = 1.0 - tail / (std::f64::consts::FRAC_PI_2 * q);
+    let got = band_fraction(Some(q), r);
+    assert!((got - want).abs() < 1e-12, "{got} vs {want}");
 }
