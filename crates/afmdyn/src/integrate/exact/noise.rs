@@ -376,7 +376,10 @@ impl ThermalExact {
     /// z_p(τ) of region `r` at (sin, cos) Ωτ = `sc`.
     fn zp(&self, r: Region, (s, c): (f64, f64)) -> DVector<f64> {
         let f: &Forced = &self.det.forced[r.index()];
-        &f.p0 + &f.ps * s + &f.pc * c
+        let mut z = f.p0.clone();
+        z.axpy(s, &f.ps, 1.0);
+        z.axpy(c, &f.pc, 1.0);
+        z
     }
 
     /// z − z_p(τ) of region `r`, (sin, cos) Ωτ = `sc`, into `out`.
@@ -482,7 +485,8 @@ impl ThermalExact {
         self.normals(0, &mut zeta);
         dz1.gemv(1.0, &rung.root, &zeta, 0.0);
         dz1.gemv(1.0, &rung.phi, &dz0, 1.0);
-        let z1 = self.zp(r, sc1) + &dz1;
+        let mut z1 = self.zp(r, sc1);
+        z1 += &dz1;
         let clear = self.gap(r, sc1, &z1) > 0.0
             && self.mid_gap(r, rung, turn(sc0, rung.half_turn), &dz0, &dz1)
                 > KAPPA * rung.mid.tip_sd;
