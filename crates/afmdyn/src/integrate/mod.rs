@@ -233,8 +233,9 @@ pub trait Integrator: Send {
     /// # Errors
     /// [`SimError`] for a non-finite τ or a state of the wrong length or with non-finite entries.
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError>;
-    /// Advance by one step, never past `tau_max` (the exact propagator ends on its grid point
-    /// when `tau_max` is within 4 ulps short of it).
+    /// Advance by one step, never past `tau_max` (the exact propagators end on their grid point
+    /// when `tau_max` is a few ulps short of it: 4 for the deterministic one; the stochastic
+    /// step within 1e-9 of its step or 8 ulps).
     ///
     /// # Errors
     /// [`SimError::Chattering`], [`SimError::Diverged`] or an integrator failure.

@@ -4,6 +4,7 @@
 use super::analyses::{check_samples_per_period, IntegratorRequest};
 use super::limits::*;
 use crate::error::SimError;
+use crate::integrate::exact::noise::holding_samples;
 use crate::integrate::exact::{ThermalExact, ThermalForce};
 use crate::integrate::{Integrator, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -220,8 +221,7 @@ impl SimulateRequest {
                  temperature",
             ));
         }
-        let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
-        Ok(Some(ThermalForce::new(kt, self.seed)))
+        super::thermal::thermal_force(t, self.seed, probe).map(Some)
     }
 
     /// The warnings of the request: a temperature outside the laboratory's range.
@@ -254,21 +254,10 @@ impl SimulateRequest {
                 "thermal noise is advanced by the exact stochastic step: auto or exact",
             ));
         }
-        // the least common multiple of the steps and the samples per period
-        let (a, s) = (opts.steps_per_period.max(1), self.samples_per_period.max(1));
-        opts.steps_per_period = a / gcd(a, s) * s;
+        opts.steps_per_period = holding_samples(opts.steps_per_period, self.samples_per_period);
         let mut it = ThermalExact::new(model, &opts, force)?;
         it.reset(0.0, z0)?;
         Ok(Box::new(it))
-    }
-}
-
-/// The greatest common divisor (Euclid).
-fn gcd(a: usize, b: usize) -> usize {
-    if b == 0 {
-        a
-    } else {
-        gcd(b, a % b)
     }
 }
 

@@ -102,6 +102,22 @@ pub fn check_temperature(t: f64) -> Result<(), SimError> {
     ))
 }
 
+/// The thermal force of a simulated measurement at `t` (K) under `probe` with `seed`: the
+/// temperature checked ([`check_temperature`]) and k_B T in the probe's energy unit
+/// (`simulate`'s and the PI scan's, [`crate::integrate::exact::noise`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `temperature`.
+pub(crate) fn thermal_force(
+    t: f64,
+    seed: u64,
+    probe: &crate::probe::Probe,
+) -> Result<crate::integrate::exact::ThermalForce, SimError> {
+    check_temperature(t)?;
+    let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
+    Ok(crate::integrate::exact::ThermalForce::new(kt, seed))
+}
+
 /// The checks of a temperature `t` (K) and a laser spot `spot` shared by the thermal
 /// requests: a probe, T in (0, 1500] K, 0 < spot ≤ 1.
 ///

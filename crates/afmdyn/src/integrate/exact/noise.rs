@@ -71,12 +71,16 @@ pub const KAPPA: f64 = 6.0;
 const DENSE_STREAM: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// The thermal force of a run: k_B T in the model's energy unit and the seed of its stream.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ThermalForce {
     /// k_B T / (force × length unit): the model's k_B T.
     pub kt: f64,
     /// The seed of the random stream.
     pub seed: u64,
+    /// The ChaCha stream of the seed (its 64-bit nonce): 0 for one run; a scan draws each
+    /// line's and material's force from a stream of its own ([`ThermalForce::stream`]), so
+    /// that they are independent and each a function of the seed and its index alone.
+    pub stream: u64,
 }
 
 impl ThermalForce {
@@ -84,8 +88,59 @@ impl ThermalForce {
     /// F₀ and L₀ the newtons and metres per unit force and length, the caller's SI scales:
     /// the integrator is dimensionless), drawn from the stream of `seed`.
     pub fn new(kt: f64, seed: u64) -> ThermalForce {
-        ThermalForce { kt, seed }
+        ThermalForce {
+            kt,
+            seed,
+            stream: 0,
+        }
     }
+
+    /// The same force drawn from stream `stream` of the seed.
+    pub fn stream(self, stream: u64) -> ThermalForce {
+        ThermalForce { stream, ..self }
+    }
+}
+
+/// The least multiple of `steps` grid steps per period (at least 1) that holds `samples`
+/// equally spaced samples per period as grid points (also at least 1), where the stochastic
+/// step has its drawn points (a sample between them is drawn from the bridge).
+pub(crate) fn holding_samples(steps: usize, samples: usize) -> usize {
+    let (a, s) = (steps.max(1), samples.max(1));
+    let gcd = |mut x: usize, mut y: usize| {
+        while y != 0 {
+            (x, y) = (y, x % y);
+        }
+        x
+    };
+    a / gcd(a, s) * s
+}
+
+/// Whether the exact stochastic step can integrate `law`: the piecewise-linear law only.
+///
+/// # Errors
+/// [`SimError::Unsupported`] naming the law (the nonlinear laws' stochastic integration is not
+/// built).
+pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
+    if law.is_affine() {
+        return Ok(());
+    }
+    Err(SimError::Unsupported {
+        integrator: "exact-thermal",
+        law: law.name(),
+        hint: "thermal noise (temperature) is simulated for the linear law only, by the exact \
+               stochastic step; drop temperature for this law",
+    })
+}
+
+/// How far apart, in ulps of τ, a target time and the lattice point it names may be rounded
+/// (a sample time start + k·T/S against the lattice's p·T + k·h).
+const ROUNDING_ULPS: f64 = 8.0;
+
+/// ChaCha8 from `seed` on `stream`.
+fn seeded(seed: u64, stream: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(stream);
+    rng
 }
 
 /// The diffusion GGᵀ = [[0, 0], [0, M⁻¹ 2k_BT C_s M⁻¹]] of region `r` of `model` (2N × 2N).
@@ -256,6 +311,8 @@ fn turn((s, c): (f64, f64), (sp, cp): (f64, f64)) -> (f64, f64) {
 pub struct ThermalExact {
     /// The deterministic propagator: the model, the grid and the particular solutions.
     det: ExactPropagator,
+    /// Its build options (rebuilt at a new gap, [`Integrator::set_gap`]).
+    exact: ExactOptions,
     /// The model (the propagator's, for [`Integrator::system`]).
     model: CantileverModel,
     force: ThermalForce,
@@ -297,22 +354,13 @@ impl ThermalExact {
         opts: &IntegratorOptions,
         force: ThermalForce,
     ) -> Result<ThermalExact, SimError> {
-        if !model.law().is_affine() {
-            return Err(SimError::Unsupported {
-                integrator: "exact-thermal",
-                law: model.law().name(),
-                hint: "thermal noise (temperature) is simulated for the linear law only, by the \
-                       exact stochastic step; drop temperature for this law",
-            });
-        }
-        let det = ExactPropagator::try_with(
-            model,
-            ExactOptions {
-                min_steps_per_period: opts.steps_per_period,
-                cache: Some(opts.cache.clone()),
-                ..ExactOptions::default()
-            },
-        )?;
+        admits(model.law())?;
+        let exact = ExactOptions {
+            min_steps_per_period: opts.steps_per_period,
+            cache: Some(opts.cache.clone()),
+            ..ExactOptions::default()
+        };
+        let det = ExactPropagator::try_with(model, exact.clone())?;
         let diffusion = [Region::Free, Region::Contact].map(|r| diffusion(model, r, force.kt));
         let h = det.grid.h;
         let omega = model.omega();
@@ -323,13 +371,14 @@ impl ThermalExact {
         let n = 2 * model.modes();
         Ok(ThermalExact {
             det,
+            exact,
             model: model.clone(),
             force,
             diffusion,
             ladders,
             odd: None,
-            rng: ChaCha8Rng::seed_from_u64(force.seed),
-            dense_rng: ChaCha8Rng::seed_from_u64(force.seed ^ DENSE_STREAM),
+            rng: seeded(force.seed, force.stream),
+            dense_rng: seeded(force.seed ^ DENSE_STREAM, force.stream),
             tau: 0.0,
             sc: (0.0, 1.0),
             z: DVector::zeros(n),
@@ -423,6 +472,19 @@ impl ThermalExact {
     }
 
     /// τ of ladder position (j, i).
+    /// How near to a time `t` a lattice point is taken for it: 1e-9 h, or [`ROUNDING_ULPS`]
+    /// ulps of `t` where they are more.
+    fn slack(&self, t: f64) -> f64 {
+        (1e-9 * self.det.grid.h).max(ROUNDING_ULPS * f64::EPSILON * t.abs())
+    }
+
+    /// Whether a piece ending at `t` is within `tau_max`: at or before it, or past it by at
+    /// most [`ThermalExact::slack`], as the exact propagator's step ends on its grid point
+    /// (a piece to it stays a tabulated one, not one of an ulp with a ladder of its own).
+    fn short_of(&self, t: f64, tau_max: f64) -> bool {
+        t <= tau_max + self.slack(tau_max)
+    }
+
     fn lattice_tau(&self, (j, i): (i64, u64)) -> f64 {
         self.det.grid.tau(j) + i as f64 * self.det.grid.h / (1u64 << LEVELS) as f64
     }
@@ -439,7 +501,7 @@ impl ThermalExact {
             let i1 = i + (top >> k);
             let end = if i1 == top { (j + 1, 0) } else { (j, i1) };
             let len = self.det.grid.h / (1u64 << k) as f64;
-            if self.lattice_tau(end) <= tau_max {
+            if self.short_of(self.lattice_tau(end), tau_max) {
                 return (len, k, Some(end), None);
             }
         }
@@ -447,7 +509,7 @@ impl ThermalExact {
         // or to tau_max
         let jn = self.det.grid.next_index(self.tau);
         let t_grid = self.det.grid.tau(jn);
-        let (t1, at) = if t_grid <= tau_max {
+        let (t1, at) = if self.short_of(t_grid, tau_max) {
             (t_grid, Some((jn, 0)))
         } else {
             (tau_max, None)
@@ -547,6 +609,24 @@ impl Integrator for ThermalExact {
         "exact-thermal"
     }
 
+    /// The sample moved to α5 = `alpha5`: the model's constant forcing and the propagator's
+    /// particular solutions rebuilt; Φ, Q and the bridges do not depend on the gap, and the
+    /// random stream goes on (a scan's thermal force is one stream over its line, not one
+    /// restarted every drive period).
+    fn set_gap(&mut self, alpha5: f64) -> bool {
+        let mut model = self.model.clone();
+        if model.set_gap(alpha5).is_err() {
+            return false;
+        }
+        match ExactPropagator::try_with(&model, self.exact.clone()) {
+            Ok(det) => {
+                (self.model, self.det) = (model, det);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;
         let j = self.det.grid.next_index(tau) - 1;
@@ -566,6 +646,14 @@ impl Integrator for ThermalExact {
         self.points.push((tau0, self.z.clone()));
         self.last_region = from;
         while self.tau < tau_max {
+            if self.short_of(tau_max, self.tau) {
+                // a target rounded a little past the point just reached is that point: the
+                // state is kept (no piece of an ulp with a ladder of its own), its lattice
+                // position too
+                self.tau = tau_max;
+                self.sc = (self.model().omega() * tau_max).sin_cos();
+                break;
+            }
             let piece = self.next_piece(tau_max);
             let start = self.at;
             if let Some((tc, zc, off)) = self.take_piece(&piece) {
@@ -615,7 +703,7 @@ impl Integrator for ThermalExact {
     /// The drawn point at `tau`, else a draw from the bridge between the nearest drawn points
     /// of the last step (the second stream), kept so that later draws are conditioned on it.
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
-        let tol = 1e-9 * self.det.grid.h;
+        let tol = self.slack(tau);
         let pos = self.points.partition_point(|p| p.0 < tau - tol);
         if let Some(p) = self.points.get(pos).filter(|p| (p.0 - tau).abs() <= tol) {
             return p.1.clone();

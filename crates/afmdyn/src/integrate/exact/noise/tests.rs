@@ -425,3 +425,90 @@ fn the_ensemble_from_rest_follows_the_oscillators_response() {
         );
     }
 }
+
+/// The lock-in's output noise on a driven free lever against the linear response from the
+/// thermal spectrum: with W = W_p + n, n the stationary thermal motion of one-sided PSD S(f)
+/// (`thermal_spectrum`), the lock-in's output after period K is linear in the samples n(t_s),
+/// Σ_s c_s n(t_s), with c_s = β(1 − β)^k (2/M) sin(θ_j − φ) for the amplitude (cos for A δφ) at
+/// sample j of period K − k (`crate::analysis::am_loop`'s rectangle rule and first-order
+/// low-pass), so Var = ∫₀^∞ S(f) |Σ_s c_s e^{2πi f t_s}|² df (R(t) = ∫₀^∞ S(f) cos 2πft df):
+/// |G(f)|² |D(f)|² with G(f) = β/(1 − (1 − β)e^{−2πifT}) and D(f) = (2/M) Σ_j sin(θ_j − φ)
+/// e^{2πif jT/M}. Simulated over 30 000 periods (τ_L = 8T) within 5 standard errors of an
+/// AR(1) output's variance estimate, σ ≈ (2(1 + ρ²)/((1 − ρ²)P))^{1/2}, ρ = 1 − β.
+#[test]
+fn the_lock_in_output_carries_the_thermal_noise_of_its_bandwidth() {
+    use crate::analysis::am_loop::{demodulate_period, LockIn};
+    use std::f64::consts::TAU;
+    let p = water_linear(1e-6, 5e-9);
+    let model = CantileverModel::new(&p.params).unwrap();
+    let samples = 32;
+    let opts = IntegratorOptions {
+        steps_per_period: holding_samples(1, samples),
+        ..IntegratorOptions::default()
+    };
+    let mut it = ThermalExact::new(&model, &opts, ThermalForce::new(kt_model(&p), 5)).unwrap();
+    let z0 = it.zp(Region::Free, (0.0, 1.0));
+    it.reset(0.0, &z0).unwrap();
+    let period = model.period();
+    let time_constant = 8.0 * period;
+    let (a_det, phi) = demodulate_period(&mut it.clone(), &model, samples).unwrap();
+    let mut lock = LockIn::new(time_constant, period, a_det, phi);
+    let (burn, periods) = (200, 30_000);
+    let (mut a, mut ph) = (Vec::new(), Vec::new());
+    for k in 0..burn + periods {
+        let (ak, pk) = demodulate_period(&mut it, &model, samples).unwrap();
+        lock.update(ak, pk);
+        // as the scan does (`am_loop::scan_line`), each period from τ = 0, the stream going on
+        let z = it.state().clone();
+        it.reset(0.0, &z).unwrap();
+        if k >= burn {
+            a.push(lock.amplitude());
+            ph.push(lock.phase());
+        }
+    }
+    let var = |x: &[f64]| {
+        let m = x.iter().sum::<f64>() / x.len() as f64;
+        x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1) as f64
+    };
+    let l2 = p.scales.length_m.powi(2);
+    let simulated = [var(&a) * l2, var(&ph) * (a_det * a_det) * l2];
+    // the linear response: ∫ S |G D|² df on a grid that resolves G's peaks (width β/(2πT))
+    let t_s = period * p.scales.time_s;
+    let f_d = 1.0 / t_s;
+    let beta = -(-period / time_constant).exp_m1();
+    let df = 2e-4 * f_d;
+    let f: Vec<f64> = (1..200_000).map(|i| i as f64 * df).collect();
+    let s = thermal_spectrum(&p.params, units(&p), 295.0, 1.0, &f, &Progress::default())
+        .unwrap()
+        .deflection;
+    let psi = model.params().drive_phase();
+    let predicted = [0, 1].map(|part| {
+        f.iter()
+            .zip(&s)
+            .map(|(&f, &s)| {
+                let x = TAU * f * t_s;
+                let g2 = beta * beta / (1.0 + (1.0 - beta).powi(2) - 2.0 * (1.0 - beta) * x.cos());
+                let (mut re, mut im) = (0.0, 0.0);
+                for j in 1..=samples {
+                    let u = j as f64 / samples as f64;
+                    let theta = TAU * u + psi - phi;
+                    let c = if part == 0 { theta.sin() } else { theta.cos() };
+                    re += c * (x * u).cos();
+                    im += c * (x * u).sin();
+                }
+                let d2 = (2.0 / samples as f64).powi(2) * (re * re + im * im);
+                s * g2 * d2 * df
+            })
+            .sum::<f64>()
+    });
+    let rho = 1.0 - beta;
+    let sigma = (2.0 * (1.0 + rho * rho) / ((1.0 - rho * rho) * periods as f64)).sqrt();
+    for (name, (sim, pred)) in ["amplitude", "phase"]
+        .iter()
+        .zip(simulated.iter().zip(predicted))
+    {
+        let ratio = sim / pred;
+        println!("{name}: σ = {:.4e} m (linear response {:.4e} m), ratio of variances {ratio:.4} ± {sigma:.4}", sim.sqrt(), pred.sqrt());
+        assert!((ratio - 1.0).abs() < 5.0 * sigma, "{name}: {ratio}");
+    }
+}
