@@ -174,10 +174,11 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "file": "afm",
         "schema": "image_scan",
         "module": "image_scan",
-        "order": ["scan_rate", "gains", "time_constant"],
-        "notes": {k: "Only with --feedback pi." for k in ["scan_rate", "gains", "time_constant"]},
+        "order": ["scan_rate", "gains", "time_constant", "temperature", "seed"],
+        "notes": {k: "Only with --feedback pi." for k in ["scan_rate", "gains", "time_constant",
+                                                           "temperature", "seed"]},
         "args": {"scan_rate": 'value_name = "HZ"', "gains": 'value_name = "P,I"',
-                 "time_constant": 'value_name = "S"'},
+                 "time_constant": 'value_name = "S"', "temperature": 'value_name = "K"'},
     },
     # `image`'s options (mode, feedback, threads, setpoint study), checked together by the
     # library (`ImageOptions::check`)

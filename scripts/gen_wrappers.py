@@ -49,8 +49,9 @@ IMAGE = {"positional": IMAGE_INPUTS + [("setpoint", "float")], "model": False,
 IMAGE_KW = [("height_map", "Optional[Any]", "None"), ("feedback", "str", '"ideal"'),
             ("scan_rate", "Optional[float]", "None"),
             ("gains", "Optional[Tuple[float, float]]", "None"),
-            ("time_constant", "Optional[float]", "None"), ("threads", "Optional[int]", "None"),
-            ("mode", "str", '"am"')]
+            ("time_constant", "Optional[float]", "None"),
+            ("temperature", "Optional[float]", "None"), ("seed", "int", "0"),
+            ("threads", "Optional[int]", "None"), ("mode", "str", '"am"')]
 OPTIONAL_FLOAT = ("Optional[float]", "None")
 
 #: the generated modules: file -> the analyses it holds, each name -> (schema stem or None,

@@ -44,7 +44,7 @@ pub struct ImageArgs {
     /// The image's options: --mode, --feedback, --threads, --setpoint-study
     #[command(flatten)]
     options: ImageOptionsFlags,
-    /// The PI scan's flags: --scan-rate, --gains, --time-constant
+    /// The PI scan's flags: --scan-rate, --gains, --time-constant, --temperature, --seed
     #[command(flatten)]
     scan: PiScanFlags,
     /// PI scan: continue an interrupted scan; refused unless the other arguments are those of
@@ -85,6 +85,8 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             "time_constant",
             a.scan.time_constant.as_ref().map(|q| q.to_string()),
         ),
+        ("temperature", a.scan.temperature.map(|t| t.to_string())),
+        ("seed", (a.scan.seed != 0).then(|| a.scan.seed.to_string())),
         (
             "curve_points",
             a.request.curve_points.map(|n| n.to_string()),

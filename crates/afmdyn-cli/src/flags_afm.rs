@@ -52,6 +52,12 @@ pub struct PiScanFlags {
     /// `--time-constant`: the request's `time_constant`.
     #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range, section feedback); outside 1 µs–0.1 s the image warns of a likely unit slip. Not given: τ_c/4. Only with --feedback pi.")]
     pub time_constant: Option<f64>,
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise. With one the lines are integrated by the exact stochastic step of the linear law (the other laws are refused), and the lock-in's amplitude and phase, the height and the error images carry the noise the lever's thermal motion gives them at the lock-in's bandwidth (the pixels' energy residual then holds the thermal force's work, which the balance leaves out). Only with --feedback pi.")]
+    pub temperature: Option<f64>,
+    /// `--seed`: the request's `seed`.
+    #[arg(long, default_value = "0", help = "The seed of the thermal force (with --temperature; default 0): each line draws from streams of its own, so that an image is a function of its seed whatever the threads or the executor. Only with --feedback pi.")]
+    pub seed: u64,
 }
 
 impl PiScanFlags {
@@ -63,6 +69,8 @@ impl PiScanFlags {
         Ok(PiScan {
             gains: numbers(self.gains.as_deref(), "gains", "P,I")?.map(|[v0, v1]| (v0, v1)),
             scan_rate: quantity(self.scan_rate, "scan-rate", Dim::Frequency, si)?,
+            seed: self.seed,
+            temperature: self.temperature,
             time_constant: self.time_constant,
         })
     }

@@ -115,6 +115,33 @@ fn bad_input_exits_2_naming_the_field() {
             "threads = 2: only with feedback = pi",
         ),
         (
+            vec!["--setpoint", "0.7", "--temperature", "295"],
+            "temperature = 295: only with feedback = pi",
+        ),
+        (
+            vec![
+                "--setpoint",
+                "0.7",
+                "--feedback",
+                "pi",
+                "--temperature",
+                "0",
+            ],
+            "temperature = 0",
+        ),
+        // the DMT law of this probe: the thermal force is the linear law's
+        (
+            vec![
+                "--setpoint",
+                "0.7",
+                "--feedback",
+                "pi",
+                "--temperature",
+                "295",
+            ],
+            "dmt",
+        ),
+        (
             vec!["--setpoint", "0.7", "--feedback", "pi", "--gains", "-1,10"],
             "gains",
         ),
@@ -505,6 +532,7 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
         scan_rate: Some(40.0),
         gains: Some((0.1, 2000.0)),
         time_constant: Some(20e-6),
+        ..PiScan::default()
     };
     let lib = pi_image(&table, &map, &req, &scan, Some(1), &Progress::new()).unwrap();
     let lib = afmdyn::report::present::image::pi_summary(&lib, 0.5);
@@ -708,4 +736,62 @@ fn image_takes_files() {
         err.contains("--resume: --files none keeps no store"),
         "{err}"
     );
+}
+
+/// `--feedback pi --temperature 295 --seed 3` over a linear sample (the water beam): the scan
+/// runs, its document records the temperature and the seed, and the same seed repeats the
+/// scan's height errors bit for bit while another seed gives others.
+#[test]
+fn a_pi_scan_with_a_temperature_is_its_seeds() {
+    let dir = tempfile::tempdir().unwrap();
+    let water = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/probe-water-beam.toml"
+    ))
+    .unwrap();
+    let (head, rest) = water.split_at(water.find("[sample]").unwrap());
+    let tail = &rest[rest.find("[drive]").unwrap()..];
+    let probe = dir.path().join("water-linear.toml");
+    std::fs::write(
+        &probe,
+        format!("{head}[sample]\nlaw = \"linear\"\nstiffness = 1.0\n{tail}"),
+    )
+    .unwrap();
+    let map = dir.path().join("flat.toml");
+    std::fs::write(&map, "size = [1e-6, 0]\n").unwrap();
+    let run = |seed: &str| {
+        let out = afmdyn(&[
+            "image",
+            "--probe",
+            probe.to_str().unwrap(),
+            "--sample",
+            map.to_str().unwrap(),
+            "--setpoint",
+            "0.7",
+            "--pixels",
+            "6",
+            "--feedback",
+            "pi",
+            "--temperature",
+            "295",
+            "--seed",
+            seed,
+            "--files",
+            "none",
+            "--json",
+            "--out",
+            dir.path().join(format!("out-{seed}")).to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let doc = run("3");
+    assert_eq!(doc["scan"]["temperature"], 295.0);
+    assert_eq!(doc["scan"]["seed"], 3);
+    assert_eq!(doc["artefacts"], run("3")["artefacts"]);
+    assert_ne!(doc["artefacts"], run("4")["artefacts"]);
 }

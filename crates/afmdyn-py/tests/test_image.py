@@ -233,3 +233,33 @@ def test_the_dask_scan_equals_the_local_scan(tmp_path):
     with pytest.warns(afmdyn.AfmdynWarning):
         ref = afmdyn.image(probe, two, 0.5, feedback="pi", progress=False, **keywords)
     xr.testing.assert_identical(ds, ref)
+
+
+def test_a_pi_scan_with_a_temperature_is_the_command_lines_and_its_seeds(cli_json, tmp_path):
+    # the water beam over a linear sample (the thermal force is the linear law's): the scan is
+    # the command line's for the same seed, another seed gives another image; the DMT probe
+    # is refused naming its law, a temperature without the PI scan naming the temperature
+    water = (EXAMPLES / "probe-water-beam.toml").read_text()
+    head, rest = water[: water.index("[sample]")], water[water.index("[sample]"):]
+    probe = tmp_path / "water-linear.toml"
+    probe.write_text(head + '[sample]\nlaw = "linear"\nstiffness = 1.0\n'
+                     + rest[rest.index("[drive]"):])
+    flat = "size = [1.0e-6, 0.0]\n"
+    (tmp_path / "flat.toml").write_text(flat)
+    keywords = dict(pixels=6, feedback="pi", temperature=295.0, progress=False)
+    ds = afmdyn.image(probe, flat, 0.7, seed=3, **keywords)
+    doc = cli_json(
+        "image", "--probe", probe, "--sample", tmp_path / "flat.toml", "--setpoint", "0.7",
+        "--pixels", "6", "--feedback", "pi", "--temperature", "295", "--seed", "3",
+        "--out", tmp_path / "out",
+    )
+    assert afmdyn.summary(ds) == doc
+    scan = json.loads(ds.attrs["scan"])
+    assert (scan["temperature"], scan["seed"]) == (295.0, 3)
+    other = afmdyn.image(probe, flat, 0.7, seed=4, **keywords)
+    assert not np.array_equal(ds.height.values, other.height.values)
+    with pytest.raises(ValueError, match="dmt"):
+        afmdyn.image(_lever_q100(tmp_path), STRIPE, 0.5, pixels=4, feedback="pi",
+                     temperature=295.0)
+    with pytest.raises(ValueError, match="temperature = 295: only with feedback = pi"):
+        afmdyn.image(probe, flat, 0.7, temperature=295.0)

@@ -504,3 +504,60 @@ fn a_worker_scans_the_lines_of_the_start_bit_for_bit() {
     }
     assert!(worker.run("not a start", 0, &cancel).is_err());
 }
+
+/// examples/probe-water-beam.toml (three modes in water, Q₁ ≈ 2.3) over a linear sample.
+fn water_linear() -> toml::Table {
+    let mut p: toml::Table = repo("examples/probe-water-beam.toml").parse().unwrap();
+    p["sample"] = toml::toml! { law = "linear" stiffness = 1.0 }.into();
+    p
+}
+
+/// With a temperature the scan is a function of its seed: 1 and 2 threads give the same
+/// document, another seed another one; the thermal force moves every pixel (the heights of a
+/// flat sample spread, where without it they are one value), by far less than the free
+/// amplitude; a law other than the linear one is refused naming it.
+#[test]
+fn a_thermal_scan_is_its_seeds() {
+    let p = water_linear();
+    let m = SampleMap::parse("size = [1.0e-6, 0.2e-6]\n", "<test>").unwrap();
+    let req = ImageRequest {
+        pixels: 8,
+        lines: Some(2),
+        ..ImageRequest::at(0.7)
+    };
+    let run = |temperature: Option<f64>, seed: u64, threads: usize| {
+        let s = PiScan {
+            temperature,
+            seed,
+            ..PiScan::default()
+        };
+        pi_image(&p, &m, &req, &s, Some(threads), &Progress::new())
+            .unwrap()
+            .document(0.7)
+    };
+    let one = run(Some(295.0), 1, 1);
+    assert_eq!(one, run(Some(295.0), 1, 2));
+    let other = run(Some(295.0), 2, 1);
+    assert_ne!(one["image"]["height"], other["image"]["height"]);
+    let spread = |d: &Value| {
+        let h: Vec<f64> = (0..2).flat_map(|dir| row(d, dir, "height", 1e9)).collect();
+        let mean = h.iter().sum::<f64>() / h.len() as f64;
+        (h.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / h.len() as f64).sqrt()
+    };
+    let cold = run(None, 1, 1);
+    let (hot, still) = (spread(&one), spread(&cold));
+    println!("height spread: {hot:.4} nm with the thermal force, {still:.2e} nm without");
+    assert!(still < 1e-6, "{still}");
+    assert!(hot > 1e-3 && hot < 1.0, "{hot}");
+    // the lines' streams differ: two lines over a map without y-structure are not equal
+    assert_ne!(one["image"]["height"][0], one["image"]["height"][1]);
+    let dmt = probe(100.0);
+    let s = PiScan {
+        temperature: Some(295.0),
+        ..PiScan::default()
+    };
+    match pi_image(&dmt, &m, &req, &s, Some(1), &Progress::new()) {
+        Err(SimError::Unsupported { law, .. }) => assert_eq!(law, "dmt"),
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}

@@ -291,6 +291,8 @@ def image(
     scan_rate: Optional[float] = None,
     gains: Optional[Tuple[float, float]] = None,
     time_constant: Optional[float] = None,
+    temperature: Optional[float] = None,
+    seed: int = 0,
     mode: str = "am",
 ) -> xr.Dataset:
     """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
@@ -327,6 +329,11 @@ def image(
         gains: the PI controller's (K_P, K_I in 1/s; ``None``: the lever's defaults).
         time_constant: the PI scan's lock-in time constant (s), refused above 1000 s and
             warned outside 1 µs–0.1 s (``None``: the lever's default).
+        temperature: the PI scan's temperature (K; ``None``: no thermal noise): the lever's
+            thermal force on every line, the linear law only, so that the amplitude, phase,
+            height and error images carry the noise of the lock-in's bandwidth.
+        seed: the seed of the PI scan's thermal force (with ``temperature``): the image is a
+            function of it, whatever the threads or the executor.
         mode: ``"am"`` or ``"peakforce"`` (an off-resonance probe).
 
     Returns:

@@ -32,11 +32,13 @@ def _keywords(a: Args, feedback: str) -> Tuple[str, Args]:
     if gains is not None and len(gains) != 2:
         raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
     pi = dict(scan_rate=a["scan_rate"], time_constant=a["time_constant"],
-              gains=None if gains is None else [float(g) for g in gains])
+              gains=None if gains is None else [float(g) for g in gains],
+              temperature=a.get("temperature"), seed=a.get("seed") or 0)
     # the options and what else was given, checked together by the library
     # (ImageOptions::check, as the command line's flags are)
-    given = [[k, repr(a[k])] for k in ("scan_rate", "gains", "time_constant", "curve_points")
-             if a.get(k) is not None]
+    given = [[k, repr(a[k])] for k in ("scan_rate", "gains", "time_constant", "temperature",
+                                       "curve_points") if a.get(k) is not None]
+    given += [["seed", repr(a["seed"])]] if a.get("seed") else []
     options = dict(mode=mode, feedback=feedback, threads=a.get("threads"))
     request = dict(sample=os.fspath(sample) if isinstance(sample, os.PathLike) else sample,
                    setpoint=a["setpoint"], pixels=a["pixels"], lines=a["lines"],

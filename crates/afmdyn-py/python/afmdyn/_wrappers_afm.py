@@ -1095,6 +1095,8 @@ def image(
     scan_rate: Optional[float] = None,
     gains: Optional[Tuple[float, float]] = None,
     time_constant: Optional[float] = None,
+    temperature: Optional[float] = None,
+    seed: int = 0,
     threads: Optional[int] = None,
     mode: str = "am",
     progress: ProgressArg = None,
@@ -1134,6 +1136,11 @@ def image(
         gains: the PI controller's (K_P, K_I in 1/s; ``None``: the lever's defaults).
         time_constant: the PI scan's lock-in time constant (s), refused above 1000 s and
             warned outside 1 µs–0.1 s (``None``: the lever's default).
+        temperature: the PI scan's temperature (K; ``None``: no thermal noise): the lever's
+            thermal force on every line, the linear law only, so that the amplitude, phase,
+            height and error images carry the noise of the lock-in's bandwidth.
+        seed: the seed of the PI scan's thermal force (with ``temperature``): the image is a
+            function of it, whatever the threads or the executor.
         threads: the cores a PI scan's or PeakForce image's lines run on (default all).
         mode: ``"am"`` or ``"peakforce"`` (an off-resonance probe).
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
@@ -1235,7 +1242,8 @@ def image(
     Raises:
         ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside
             1..=4096 (lines = 1 for a line map), a sample map's key, a scan setting
-            (scan_rate, gains, time_constant).
+            (scan_rate, gains, time_constant, temperature: a law other than the linear one is
+            refused with it).
     """
     return _image._finish_image(locals())
 

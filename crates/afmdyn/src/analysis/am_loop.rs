@@ -37,6 +37,7 @@
 use super::observables::{observe, wrap_phase, ObservableOptions, Observables};
 use crate::error::SimError;
 use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
+use crate::integrate::exact::noise::{holding_samples, ThermalExact, ThermalForce};
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -283,6 +284,11 @@ pub(crate) struct LineSpec {
     /// The integrator (not serialised: a scan's is the default, [`IntegratorOptions::default`]).
     #[serde(skip)]
     pub integrator: IntegratorOptions,
+    /// The thermal force (k_B T in the model's energy unit and the seed; `None`: no noise).
+    /// Line t draws material m's force from stream t × materials + m of the seed
+    /// ([`ThermalForce::stream`]), one stream over the whole line: the exact stochastic step
+    /// moved to each period's gap in place ([`Integrator::set_gap`]), its stream going on.
+    pub thermal: Option<ThermalForce>,
 }
 
 /// Where a line engages: far above its first pixel's material, on the steady state there.
@@ -325,17 +331,33 @@ type Kept = (CantileverModel, Box<dyn Integrator>);
 /// of `mat` with α5 replaced give, bit for bit (their errors included), but the model and the
 /// integrator of `kept` moved to the gap in place ([`CantileverModel::set_gap`],
 /// [`Integrator::set_gap`]) where there are some, instead of assembled every drive period.
+/// With a `thermal` force the integrator is the exact stochastic step, built once and moved
+/// from gap to gap, so that its random stream goes on.
+///
+/// # Errors
+/// As [`CantileverModel::new`], [`build`] and [`ThermalExact::new`] (a law other than the
+/// linear one with a thermal force).
 fn at_gap<'a>(
     kept: &'a mut Option<Kept>,
     mat: &Params,
     alpha5: f64,
     z: &DVector<f64>,
     opts: &IntegratorOptions,
+    thermal: Option<ThermalForce>,
 ) -> Result<(&'a CantileverModel, &'a mut Box<dyn Integrator>), SimError> {
     let reused = match kept {
         Some((model, integ)) => {
             model.set_gap(alpha5)?;
-            integ.set_gap(alpha5)
+            let moved = integ.set_gap(alpha5);
+            if !moved && thermal.is_some() {
+                // a rebuilt stochastic step would start its stream again
+                return Err(SimError::out_of_range(
+                    "alpha5",
+                    crate::error::number(alpha5),
+                    "the thermal scan could not move its propagator to this gap",
+                ));
+            }
+            moved
         }
         None => false,
     };
@@ -351,7 +373,14 @@ fn at_gap<'a>(
             None => CantileverModel::new(&mat.with(SweepParam::Alpha5, alpha5))?,
         };
         let start = fit_state(z, model.dim());
-        let integ = build(&model, opts.clone(), 0.0, &start)?;
+        let integ: Box<dyn Integrator> = match thermal {
+            None => build(&model, opts.clone(), 0.0, &start)?,
+            Some(force) => {
+                let mut it = ThermalExact::new(&model, opts, force)?;
+                it.reset(0.0, &start)?;
+                Box::new(it)
+            }
+        };
         *kept = Some((model, integ));
     }
     let (model, integ) = kept.as_mut().expect("kept above");
@@ -408,7 +437,8 @@ pub(crate) fn engage_position(spec: &LineSpec) -> f64 {
 /// Scan one line (module docs): engage at the line's start for `engage_periods` from `engage`,
 /// then the trace over `pixels` × `periods_per_pixel` drive periods and the retrace back.
 /// `under_tip(s)` is the material and the true height (g₀) at the position s ∈ [0, pixels]
-/// along the line (in pixels, x increasing).
+/// along the line (in pixels, x increasing); `line` numbers the line's thermal streams
+/// ([`LineSpec::thermal`]).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `periods_per_pixel`, `samples` or `materials` when 0;
@@ -418,6 +448,7 @@ pub(crate) fn scan_line(
     spec: &LineSpec,
     engage: &Engage,
     under_tip: &dyn Fn(f64) -> (usize, f64),
+    line: usize,
     cancel: &AtomicBool,
 ) -> Result<ScanLine, SimError> {
     for (name, n) in [
@@ -450,6 +481,17 @@ pub(crate) fn scan_line(
     // each material's model and integrator, kept across the line and moved to each period's
     // gap in place (`at_gap`)
     let mut kept: Vec<Option<Kept>> = spec.materials.iter().map(|_| None).collect();
+    let materials = spec.materials.len() as u64;
+    // the exact stochastic step's grid holds the lock-in's samples
+    let holding = IntegratorOptions {
+        steps_per_period: holding_samples(spec.integrator.steps_per_period, spec.samples),
+        ..spec.integrator.clone()
+    };
+    let integrator = if spec.thermal.is_some() {
+        &holding
+    } else {
+        &spec.integrator
+    };
     // one period at position s: returns the observables when `observe_it`
     let mut period_at = |s: f64,
                          observe_it: bool,
@@ -465,7 +507,8 @@ pub(crate) fn scan_line(
             mat,
             mat.alpha5_for_rest_distance(*piezo - h),
             &z,
-            &spec.integrator,
+            integrator,
+            (spec.thermal).map(|f| f.stream(line as u64 * materials + m as u64)),
         )?;
         let (raw, o) = if observe_it {
             let o = observe(integ.as_mut(), &opts)?;

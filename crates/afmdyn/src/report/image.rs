@@ -205,6 +205,12 @@ pub struct ScanSettings {
     pub pixel_time: f64,
     /// τ_c = 2Q/ω₀ (s): the lever's amplitude time constant.
     pub amplitude_time: f64,
+    /// The temperature of the thermal force (K); absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<f64>,
+    /// The seed of the thermal force; absent without a temperature.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
 }
 
 /// One direction's artefacts of a PI scan ([`crate::request::image_scan`]).

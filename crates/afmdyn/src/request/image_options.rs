@@ -87,7 +87,14 @@ impl ImageOptions {
         match self.feedback {
             ImageFeedback::Ideal => {
                 let only = "only with feedback = pi (the ideal feedback has no loop)";
-                for name in ["scan_rate", "gains", "time_constant", "resume"] {
+                for name in [
+                    "scan_rate",
+                    "gains",
+                    "time_constant",
+                    "temperature",
+                    "seed",
+                    "resume",
+                ] {
                     if let Some(v) = value(name) {
                         return Err(SimError::out_of_range(name, v.clone(), only));
                     }
@@ -119,10 +126,12 @@ impl ImageOptions {
 }
 
 /// The names [`ImageOptions::check`] knows of the other settings a front end was given.
-const GIVEN: [&str; 5] = [
+const GIVEN: [&str; 7] = [
     "scan_rate",
     "gains",
     "time_constant",
+    "temperature",
+    "seed",
     "curve_points",
     "resume",
 ];
@@ -136,7 +145,7 @@ pub struct GivenOptions {
     /// The options.
     pub options: ImageOptions,
     /// The other settings given: `[name, value]` pairs, names among `scan_rate`, `gains`,
-    /// `time_constant`, `curve_points` and `resume`.
+    /// `time_constant`, `temperature`, `seed`, `curve_points` and `resume`.
     pub given: Vec<(String, String)>,
 }
 

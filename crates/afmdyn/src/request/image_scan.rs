@@ -55,6 +55,33 @@ pub struct PiScan {
     /// section `feedback`; [`crate::probe::ranges`]); outside 1 µs–0.1 s the image warns of a
     /// likely unit slip. `None`: τ_c/4.
     pub time_constant: Option<f64>,
+    /// The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside
+    /// 200–500 K it warns, a value in °C?); `None` (the default): no thermal noise. With one
+    /// the lines are integrated by the exact stochastic step of the linear law (the other
+    /// laws are refused), and the lock-in's amplitude and phase, the height and the error
+    /// images carry the noise the lever's thermal motion gives them at the lock-in's
+    /// bandwidth (the pixels' energy residual then holds the thermal force's work, which the
+    /// balance leaves out).
+    pub temperature: Option<f64>,
+    /// The seed of the thermal force (with `temperature`; default 0): each line draws from
+    /// streams of its own, so that an image is a function of its seed whatever the threads
+    /// or the executor.
+    pub seed: u64,
+}
+
+impl PiScan {
+    /// The thermal force of the scan under `probe`: `None` without a temperature.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `temperature`.
+    pub(crate) fn thermal(
+        &self,
+        probe: &Probe,
+    ) -> Result<Option<crate::integrate::exact::ThermalForce>, SimError> {
+        (self.temperature)
+            .map(|t| super::thermal::thermal_force(t, self.seed, probe))
+            .transpose()
+    }
 }
 
 /// What rebuilds a PI scan's study (`ScanStudy`) in any process (a Dask worker): the probe's table, the
@@ -190,6 +217,8 @@ pub(crate) fn resolve(
         lock_in_samples: LOCK_IN_SAMPLES,
         pixel_time: periods_per_pixel / f_drive,
         amplitude_time: 2.0 * q / (std::f64::consts::TAU * f0),
+        temperature: scan.temperature,
+        seed: scan.temperature.map(|_| scan.seed),
     };
     Ok((settings, gains, total))
 }

@@ -218,8 +218,7 @@ mod tests {
         let probe = crate::probe::Probe::from_table(&table, "probe").unwrap();
         let scan = PiScan {
             scan_rate: Some(probe.drive_frequency / 2200.0),
-            gains: None,
-            time_constant: None,
+            ..PiScan::default()
         };
         match ScanStudy::new(&table, &map, &req, &scan) {
             Err(e) => refused_as(e, "image"),

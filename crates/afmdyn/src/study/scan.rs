@@ -128,7 +128,7 @@ impl LineJob {
             (m, map.height_at(x, y) / g0)
         };
         let first = under_tip(engage_position(&self.spec)).0;
-        scan_line(&self.spec, &self.engage[first], &under_tip, cancel)
+        scan_line(&self.spec, &self.engage[first], &under_tip, t, cancel)
     }
 }
 
@@ -151,14 +151,23 @@ impl ScanStudy {
         let probe =
             Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
         let (settings, gains, total) = resolve(&probe, map, req, scan)?;
+        let thermal = scan.thermal(&probe)?;
         let pixels = req.pixels;
         // the lines' drive periods (× modes) and the pixels' memory, with the curves' cost
         let extra = crate::request::limits::Cost {
             bytes: req.pixel_bytes(map),
             work: total,
         };
-        let (curves, of_domain, units) =
-            material_curves(probe_table, map, req.curve_points, extra)?;
+        let (curves, of_domain, units) = material_curves(
+            probe_table,
+            map,
+            req.curve_points,
+            extra,
+            &|p| match scan.temperature {
+                Some(_) => crate::integrate::exact::noise::admits(&p.contact_law),
+                None => Ok(()),
+            },
+        )?;
         let ideal = image_of(&curves, &of_domain, &units, map, req)?;
         let engage = curves
             .iter()
@@ -193,6 +202,7 @@ impl ScanStudy {
             engage_periods: settings.engage_periods,
             range: (lo, hi),
             integrator: IntegratorOptions::default(),
+            thermal,
         };
         // what a resumed scan must match: everything its lines depend on (the settings as
         // given under "feedback", named first when a resume differs; then as resolved)
@@ -298,6 +308,10 @@ impl ScanStudy {
                 .map(|w| format!("the ideal image beside the scan: {w}"))
                 .collect(),
         };
+        if let Some(t) = self.recipe.scan.temperature {
+            img.warnings
+                .extend(crate::request::thermal::temperature_warnings(t));
+        }
         // a lock-in time constant given outside the typical range: a likely unit slip, named
         // (the lever's default τ_c/4 is no slip, whatever its value)
         if let Some(tc) = self.recipe.scan.time_constant {
