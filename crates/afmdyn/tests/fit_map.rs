@@ -251,6 +251,19 @@ fn malformed_maps_are_refused_naming_the_file() {
             "{name}: {msg}"
         );
     }
+    // a NetCDF signature with a header cut short: said in words, not the reader's Debug
+    let path = dir.join("cut.nc");
+    std::fs::write(&path, b"CDF\x01\x00\x00\x00\x05\x00\x00").unwrap();
+    let msg = run(&request(&path, 1), &probe(), &Progress::default())
+        .err()
+        .expect("a cut NetCDF header was accepted")
+        .to_string();
+    assert!(
+        msg.contains("cut.nc")
+            && msg.contains("not a NetCDF-3 map: its header")
+            && !msg.contains("ParseHeader"),
+        "{msg}"
+    );
 }
 
 /// A map fitted with another lever's probe (RTESPA-300, k ≈ 40 N/m, against the map's

@@ -550,9 +550,33 @@ fn open_netcdf(path: &Path) -> Result<netcdf3::FileReader, InputFileError> {
     };
     let name = path.display().to_string();
     let reader = netcdf3::FileReader::open_seek_read(&name, Box::new(capped))
-        .map_err(|e| invalid(path, format!("not a NetCDF-3 map: {e:?}")))?;
+        .map_err(|e| invalid(path, format!("not a NetCDF-3 map: {}", read_error(&e))))?;
     parsed.store(true, Ordering::Relaxed);
     Ok(reader)
+}
+
+#[cfg(feature = "files")]
+/// A NetCDF reader's error in words (the crate's own `Display` is its `Debug`).
+fn read_error(e: &netcdf3::error::ReadError) -> String {
+    use netcdf3::error::ReadError as E;
+    match e {
+        E::ParseHeader(_) if e.header_is_incomplete() => {
+            "its header ends early (a truncated file?)".into()
+        }
+        E::ParseHeader(_) => "its header is not that of a NetCDF-3 file".into(),
+        E::DataSet(d) => d.to_string(),
+        E::VariableNotDefined(name) => format!("the file has no variable {name}"),
+        E::VariableMismatchDataType { var_name, req, get } => {
+            format!("{var_name} holds {get}, not {req}")
+        }
+        E::IOErrorKind(kind) => format!("reading it failed: {kind}"),
+        E::RecordIndexExceeded { index, num_records } => {
+            format!("record {index} is beyond its {num_records} records")
+        }
+        E::ComputationNumberOfRecords | E::Unexpected => {
+            "its records are malformed (their count or sizes)".into()
+        }
+    }
 }
 
 #[cfg(feature = "files")]
@@ -565,7 +589,7 @@ fn per_curve(
     use netcdf3::DataVector as D;
     let v = r
         .read_var(name)
-        .map_err(|e| invalid(path, format!("variable {name}: {e:?}")))?;
+        .map_err(|e| invalid(path, format!("variable {name}: {}", read_error(&e))))?;
     Ok(match v {
         D::I8(v) => v.into_iter().map(f64::from).collect(),
         D::U8(v) => v.into_iter().map(f64::from).collect(),
@@ -655,7 +679,7 @@ fn netcdf_rows(
     let mut row = |name: &str| -> Result<Vec<f64>, InputFileError> {
         let mut v = r
             .read_record_f64(name, record)
-            .map_err(|e| invalid(path, format!("{name}, curve {record}: {e:?}")))?;
+            .map_err(|e| invalid(path, format!("{name}, curve {record}: {}", read_error(&e))))?;
         v.truncate(rows);
         Ok(v)
     };
