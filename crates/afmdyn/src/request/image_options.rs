@@ -87,14 +87,8 @@ impl ImageOptions {
         match self.feedback {
             ImageFeedback::Ideal => {
                 let only = "only with feedback = pi (the ideal feedback has no loop)";
-                for name in [
-                    "scan_rate",
-                    "gains",
-                    "time_constant",
-                    "temperature",
-                    "seed",
-                    "resume",
-                ] {
+                // every setting given but the curves' is the PI scan's
+                for name in GIVEN.into_iter().filter(|n| *n != "curve_points") {
                     if let Some(v) = value(name) {
                         return Err(SimError::out_of_range(name, v.clone(), only));
                     }
