@@ -53,9 +53,6 @@ request! {
     impl Default;
 }
 
-/// Bytes in a GiB.
-const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
-
 /// The worst-case memory of the traces of a curve of `points` points at `samples` samples per
 /// drive period, in bytes: every trace over
 /// [`crate::analysis::traces::MAX_TRACE_PERIODS`] periods of
@@ -152,7 +149,7 @@ impl CurveRequest {
                         "{} points × {n} samples per period × up to {} periods: up to {:.1} GiB",
                         spec.values.len(),
                         crate::analysis::traces::MAX_TRACE_PERIODS,
-                        bytes / GIB
+                        bytes / super::limits::GIB
                     ),
                     budget: "1 GiB".into(),
                     hint: "fewer points or fewer traces samples per period",

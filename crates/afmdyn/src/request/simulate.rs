@@ -157,7 +157,7 @@ impl SimulateRequest {
                     "{:.1} GB ({rows:.3e} samples × {columns} columns)",
                     bytes / 1e9
                 ),
-                budget: format!("{:.0} GiB", budget / (1024.0 * 1024.0 * 1024.0)),
+                budget: format!("{:.0} GiB", budget / super::limits::GIB),
                 hint: "lower periods or samples_per_period, or keep no time series",
             });
         }
