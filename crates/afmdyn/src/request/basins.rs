@@ -5,7 +5,6 @@
 
 use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
 use super::costs::basins_cost;
-use super::limits::MAX_THREADS;
 use crate::analysis::basins::{
     BasinSpec, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER,
     DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
@@ -50,7 +49,7 @@ request! {
         /// Relative tolerance for two steady states to be one attractor, > 0.
         pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
         /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
-        constants(MAX_THREADS)
+        constants(MAX_THREADS in super::limits)
         pub threads: Option<usize>,
         /// The steady-state search of a start the early tests leave undecided.
         #[serde(flatten)]

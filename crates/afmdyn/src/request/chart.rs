@@ -12,7 +12,6 @@
 //! chart's axes and length unit where the chart runs.
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
-use super::limits::MAX_THREADS;
 use super::model::{parameter, ModelSpec, ValueKind};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::chart::{CellParams, ChartSpec};
@@ -82,7 +81,7 @@ request! {
         constants(MAX_CHART_SLOTS)
         pub max_attractors: usize = 8,
         /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
-        constants(MAX_THREADS)
+        constants(MAX_THREADS in super::limits)
         pub threads: Option<usize>,
         /// The steady-state search of every run.
         #[serde(flatten)]

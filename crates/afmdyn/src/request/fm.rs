@@ -12,7 +12,6 @@ use crate::analysis::approach::approach_spec;
 use crate::analysis::fm::FmSpec;
 use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
-use crate::analysis::stepped::{DEFAULT_CURVE_POINTS, MAX_CURVE_POINTS};
 use crate::error::SimError;
 use crate::report::CurveUnits;
 
@@ -40,7 +39,8 @@ request! {
         pub step: Option<f64>,
         /// Number of z_c values, ends included, 2..=[`crate::analysis::stepped::MAX_CURVE_POINTS`]
         /// (default [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
-        constants(MAX_CURVE_POINTS, DEFAULT_CURVE_POINTS)
+        constants(MAX_CURVE_POINTS in crate::analysis::stepped,
+                  DEFAULT_CURVE_POINTS in crate::analysis::stepped)
         pub points: Option<usize>,
         /// Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).
         pub tolerance: f64 = DEFAULT_LOOP_TOLERANCE,

@@ -81,7 +81,7 @@ macro_rules! impl_request {
 /// A field is `$(#[attr])* $(constants(NAME, …))? pub name: Type $(= default)?`: without
 /// `= default` it takes its type's `Default::default()`; `constants(NAME, …)` lists the
 /// constants its doc cites (limits, defaults) under the schema's `x-constants`
-/// (`{"NAME": NAME, …}`; each in scope by that name). Attributes before `pub struct` follow
+/// (`{"NAME": NAME, …}`; `NAME in path` for one not in scope, `{"NAME": path::NAME}`). Attributes before `pub struct` follow
 /// the shared ones (the doc, `#[derive(Copy)]`, schemars attributes of the whole struct); a
 /// doc of `default` itself follows the struct, as `/// … impl Default;`.
 macro_rules! request {
@@ -90,7 +90,7 @@ macro_rules! request {
         pub struct $name:ident {
             $(
                 $(#[$fattr:meta])*
-                $(constants($($c:ident),+))?
+                $(constants($($c:ident $(in $($m:ident)::+)?),+))?
                 pub $field:ident: $ty:ty $(= $default:expr)?
             ),* $(,)?
         }
@@ -105,7 +105,7 @@ macro_rules! request {
                 $(#[$fattr])*
                 $(#[cfg_attr(
                     feature = "schema",
-                    schemars(extend("x-constants" = { $(stringify!($c): $c),+ }))
+                    schemars(extend("x-constants" = { $(stringify!($c): $($($m::)+)? $c),+ }))
                 )])?
                 pub $field: $ty,
             )*

@@ -25,7 +25,7 @@ use serde_json::Value;
 /// where `each_request!` gives it its own arm): [`NAMES`], the variants of `Parsed` (and
 /// `reconstruct_document`'s, which has no name of its own there), [`parse`]'s arms and
 /// `each_request!`. Read entry by entry (`@read`, the variants of the common arm gathered), then
-/// written (`@write`).
+/// written (`@write`, given the `$` that the written `each_request!` needs as `$d`).
 macro_rules! analyses {
     (@read [$($all:tt)*] [$($plain:ident)*]) => {
         analyses!(@write ($) [$($all)*] [$($plain)*]);

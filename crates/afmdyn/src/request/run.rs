@@ -24,7 +24,7 @@ use super::costs::{check_cost_advising, stepped_cost};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
 use crate::analysis::progress::Progress;
-use crate::analysis::stepped::torus::{uses_torus, TorusOptions, TORUS_PERIODS};
+use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
 use crate::params::Params;
@@ -296,7 +296,7 @@ request! {
         /// branches and folds).
         #[serde(skip_serializing_if = "std::ops::Not::not")]
         #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
-        constants(TORUS_PERIODS)
+        constants(TORUS_PERIODS in crate::analysis::stepped::torus)
         pub exact: bool,
     }
 }
