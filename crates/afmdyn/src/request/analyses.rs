@@ -28,7 +28,6 @@ use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
-use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 mod start;
@@ -38,16 +37,15 @@ fn check_period(period: Option<usize>) -> Result<(), SimError> {
     period.map_or(Ok(()), |n| in_range("period", n, 1..=MAX_PERIOD))
 }
 
-/// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct OrbitRequest {
-    /// The period n (1..=64); `None`: the period of the steady state reached, else 1.
-    pub period: Option<usize>,
-    /// The start.
-    #[serde(flatten)]
-    pub start: StartRequest,
+request! {
+    /// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
+    pub struct OrbitRequest {
+        /// The period n (1..=64); `None`: the period of the steady state reached, else 1.
+        pub period: Option<usize>,
+        /// The start.
+        #[serde(flatten)]
+        pub start: StartRequest,
+    }
 }
 
 impl OrbitRequest {
@@ -61,39 +59,25 @@ impl OrbitRequest {
     }
 }
 
-/// `continuation`: pseudo-arclength continuation of a period-n branch in one parameter, and
-/// with `switch` the period-doubling cascade to [`CASCADE_FACTOR`] n.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ContinuationRequest {
-    /// The continued parameter: `omega` or `alpha1`..`alpha6` (or their names,
-    /// `tip-mass-ratio`, …).
-    pub param: SweepParam,
-    /// The value where the continuation starts.
-    pub from: f64,
-    /// The end of the range.
-    pub to: f64,
-    /// The period n (1..=64); `None`: the period of the steady state reached at `from`, else 1.
-    pub period: Option<usize>,
-    /// At each period doubling, switch to the period-2n branch and continue it too,
-    /// recursively up to period 8n (the period-doubling cascade).
-    pub switch: bool,
-    /// The start at `from`.
-    #[serde(flatten)]
-    pub start: StartRequest,
-}
-
-impl Default for ContinuationRequest {
-    fn default() -> Self {
-        ContinuationRequest {
-            param: SweepParam::Omega,
-            from: 5.0,
-            to: 1.0,
-            period: None,
-            switch: false,
-            start: StartRequest::default(),
-        }
+request! {
+    /// `continuation`: pseudo-arclength continuation of a period-n branch in one parameter, and
+    /// with `switch` the period-doubling cascade to [`CASCADE_FACTOR`] n.
+    pub struct ContinuationRequest {
+        /// The continued parameter: `omega` or `alpha1`..`alpha6` (or their names,
+        /// `tip-mass-ratio`, …).
+        pub param: SweepParam = SweepParam::Omega,
+        /// The value where the continuation starts.
+        pub from: f64 = 5.0,
+        /// The end of the range.
+        pub to: f64 = 1.0,
+        /// The period n (1..=64); `None`: the period of the steady state reached at `from`, else 1.
+        pub period: Option<usize>,
+        /// At each period doubling, switch to the period-2n branch and continue it too,
+        /// recursively up to period 8n (the period-doubling cascade).
+        pub switch: bool = false,
+        /// The start at `from`.
+        #[serde(flatten)]
+        pub start: StartRequest,
     }
 }
 
@@ -110,36 +94,20 @@ impl ContinuationRequest {
     }
 }
 
-/// `lyapunov`: the Lyapunov spectrum with saltation matrices and the 0–1 test.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct LyapunovRequest {
-    /// The initial state (2N values); `None`: rest.
-    pub initial: Option<Vec<f64>>,
-    /// Drive periods discarded first; `None` (default): the model's derived transient cap
-    /// ([`crate::analysis::steady::default_transient_cap`] at tol = 1e-8: 1 500 for the
-    /// paper's beam, ≈ 1.9 Q ln(1e8) for a lever of quality factor Q).
-    pub transient: Option<usize>,
-    /// Drive periods averaged; transient + periods ≤ [`MAX_RUN_PERIODS`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_RUN_PERIODS": MAX_RUN_PERIODS }))
-    )]
-    pub periods: usize,
-    /// Blocks for the uncertainty, 2..=periods.
-    pub blocks: usize,
-}
-
-impl Default for LyapunovRequest {
-    fn default() -> Self {
-        let d = LyapunovOptions::default();
-        LyapunovRequest {
-            initial: None,
-            transient: None,
-            periods: d.periods,
-            blocks: d.blocks,
-        }
+request! {
+    /// `lyapunov`: the Lyapunov spectrum with saltation matrices and the 0–1 test.
+    pub struct LyapunovRequest {
+        /// The initial state (2N values); `None`: rest.
+        pub initial: Option<Vec<f64>>,
+        /// Drive periods discarded first; `None` (default): the model's derived transient cap
+        /// ([`crate::analysis::steady::default_transient_cap`] at tol = 1e-8: 1 500 for the
+        /// paper's beam, ≈ 1.9 Q ln(1e8) for a lever of quality factor Q).
+        pub transient: Option<usize>,
+        /// Drive periods averaged; transient + periods ≤ [`MAX_RUN_PERIODS`].
+        constants(MAX_RUN_PERIODS)
+        pub periods: usize = LyapunovOptions::default().periods,
+        /// Blocks for the uncertainty, 2..=periods.
+        pub blocks: usize = LyapunovOptions::default().blocks,
     }
 }
 
@@ -171,38 +139,23 @@ impl LyapunovRequest {
     }
 }
 
-/// `attractors`: the coexisting attractors and their basin fractions from random starts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct AttractorsRequest {
-    /// Random initial states, 1..=[`MAX_ATTRACTOR_SAMPLES`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_ATTRACTOR_SAMPLES": crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES }))
-    )]
-    pub samples: usize,
-    /// Seed of the initial states.
-    pub seed: u64,
-    /// Relative tolerance for two Poincaré point sets to be the same attractor, > 0.
-    pub cluster_tol: f64,
-    /// The steady-state search of every start.
-    #[serde(flatten)]
-    pub steady: SteadyRequest,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for AttractorsRequest {
-    fn default() -> Self {
-        AttractorsRequest {
-            samples: 64,
-            seed: super::DEFAULT_SEED,
-            cluster_tol: super::DEFAULT_CLUSTER_TOL,
-            steady: SteadyRequest::default(),
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `attractors`: the coexisting attractors and their basin fractions from random starts.
+    #[derive(Copy)]
+    pub struct AttractorsRequest {
+        /// Random initial states, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+        constants(MAX_ATTRACTOR_SAMPLES)
+        pub samples: usize = 64,
+        /// Seed of the initial states.
+        pub seed: u64 = super::DEFAULT_SEED,
+        /// Relative tolerance for two Poincaré point sets to be the same attractor, > 0.
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
+        /// The steady-state search of every start.
+        #[serde(flatten)]
+        pub steady: SteadyRequest,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 
@@ -226,62 +179,37 @@ impl AttractorsRequest {
     }
 }
 
-/// `attractors` continued over a parameter (`afmdyn attractors --sweep`): a census at every
-/// value seeded from the previous value's attractors, matched to them by set distance
-/// ([`crate::analysis::global_continuation`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct GlobalContinuationRequest {
-    /// The continued parameter.
-    pub param: SweepParam,
-    /// Explicit values (in the order continued) instead of `from`, `to`, `steps`.
-    pub values: Option<Vec<f64>>,
-    /// First value.
-    pub from: f64,
-    /// Last value.
-    pub to: f64,
-    /// Number of values, 1..=[`MAX_CONTINUATION_VALUES`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CONTINUATION_VALUES": MAX_CONTINUATION_VALUES }))
-    )]
-    pub steps: usize,
-    /// Largest relative set distance of two attractors at consecutive values that are one, ≥ 0.
-    pub match_tol: f64,
-    /// Random starts per value, 1..=[`MAX_ATTRACTOR_SAMPLES`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_ATTRACTOR_SAMPLES": crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES }))
-    )]
-    pub samples: usize,
-    /// Seed of the random starts (keyed by value and start, as a sweep's).
-    pub seed: u64,
-    /// Relative tolerance for two Poincaré point sets at one value to be one attractor, > 0.
-    pub cluster_tol: f64,
-    /// The steady-state search of every start.
-    #[serde(flatten)]
-    pub steady: SteadyRequest,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for GlobalContinuationRequest {
-    fn default() -> Self {
-        GlobalContinuationRequest {
-            param: SweepParam::Omega,
-            values: None,
-            from: 1.5,
-            to: 3.0,
-            steps: 16,
-            match_tol: DEFAULT_MATCH_TOL,
-            samples: 16,
-            seed: super::DEFAULT_SEED,
-            cluster_tol: super::DEFAULT_CLUSTER_TOL,
-            steady: SteadyRequest::default(),
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `attractors` continued over a parameter (`afmdyn attractors --sweep`): a census at every
+    /// value seeded from the previous value's attractors, matched to them by set distance
+    /// ([`crate::analysis::global_continuation`]).
+    pub struct GlobalContinuationRequest {
+        /// The continued parameter.
+        pub param: SweepParam = SweepParam::Omega,
+        /// Explicit values (in the order continued) instead of `from`, `to`, `steps`.
+        pub values: Option<Vec<f64>>,
+        /// First value.
+        pub from: f64 = 1.5,
+        /// Last value.
+        pub to: f64 = 3.0,
+        /// Number of values, 1..=[`MAX_CONTINUATION_VALUES`].
+        constants(MAX_CONTINUATION_VALUES)
+        pub steps: usize = 16,
+        /// Largest relative set distance of two attractors at consecutive values that are one, ≥ 0.
+        pub match_tol: f64 = DEFAULT_MATCH_TOL,
+        /// Random starts per value, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+        constants(MAX_ATTRACTOR_SAMPLES)
+        pub samples: usize = 16,
+        /// Seed of the random starts (keyed by value and start, as a sweep's).
+        pub seed: u64 = super::DEFAULT_SEED,
+        /// Relative tolerance for two Poincaré point sets at one value to be one attractor, > 0.
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
+        /// The steady-state search of every start.
+        #[serde(flatten)]
+        pub steady: SteadyRequest,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 
@@ -322,32 +250,18 @@ impl GlobalContinuationRequest {
     }
 }
 
-/// `observe`: the observables of the steady state reached from a start (polished by Newton
-/// shooting when periodic).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ObserveRequest {
-    /// Orbit periods integrated, 1..=[`MAX_OBSERVE_PERIODS`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_OBSERVE_PERIODS": MAX_OBSERVE_PERIODS }))
-    )]
-    pub periods: usize,
-    /// Highest harmonic reported.
-    pub harmonics: usize,
-    /// The start.
-    #[serde(flatten)]
-    pub start: StartRequest,
-}
-
-impl Default for ObserveRequest {
-    fn default() -> Self {
-        ObserveRequest {
-            periods: 1,
-            harmonics: 10,
-            start: StartRequest::default(),
-        }
+request! {
+    /// `observe`: the observables of the steady state reached from a start (polished by Newton
+    /// shooting when periodic).
+    pub struct ObserveRequest {
+        /// Orbit periods integrated, 1..=[`MAX_OBSERVE_PERIODS`].
+        constants(MAX_OBSERVE_PERIODS)
+        pub periods: usize = 1,
+        /// Highest harmonic reported.
+        pub harmonics: usize = 10,
+        /// The start.
+        #[serde(flatten)]
+        pub start: StartRequest,
     }
 }
 
@@ -373,42 +287,22 @@ impl ObserveRequest {
     }
 }
 
-/// `converge`: the steady tip motion for N = 1..=`max_modes` (paper Fig. 4).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ConvergeRequest {
-    /// Largest number of modes, 1..=20.
-    pub max_modes: usize,
-    /// Drive periods of steady state compared, 1..=[`MAX_CONVERGE_PERIODS`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CONVERGE_PERIODS": MAX_CONVERGE_PERIODS }))
-    )]
-    pub periods: usize,
-    /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`];
-    /// periods × samples_per_period ≤ [`MAX_CONVERGE_SAMPLES`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = {
-            "MAX_SAMPLES_PER_PERIOD": MAX_SAMPLES_PER_PERIOD,
-            "MAX_CONVERGE_SAMPLES": MAX_CONVERGE_SAMPLES
-        }))
-    )]
-    pub samples_per_period: usize,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for ConvergeRequest {
-    fn default() -> Self {
-        ConvergeRequest {
-            max_modes: 4,
-            periods: 1,
-            samples_per_period: 200,
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `converge`: the steady tip motion for N = 1..=`max_modes` (paper Fig. 4).
+    #[derive(Copy)]
+    pub struct ConvergeRequest {
+        /// Largest number of modes, 1..=20.
+        pub max_modes: usize = 4,
+        /// Drive periods of steady state compared, 1..=[`MAX_CONVERGE_PERIODS`].
+        constants(MAX_CONVERGE_PERIODS)
+        pub periods: usize = 1,
+        /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`];
+        /// periods × samples_per_period ≤ [`MAX_CONVERGE_SAMPLES`].
+        constants(MAX_SAMPLES_PER_PERIOD, MAX_CONVERGE_SAMPLES)
+        pub samples_per_period: usize = 200,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 
@@ -448,58 +342,36 @@ pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
     Ok(())
 }
 
-/// `bifurcation`: the steady state over a grid of one parameter, continued forward and
-/// backward and from seeded random starts.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct BifurcationRequest {
-    /// The swept parameter: `omega` or `alpha1`..`alpha6` (or their names,
-    /// `tip-mass-ratio`, …).
-    pub param: SweepParam,
-    /// Explicit values instead of `from`, `to`, `steps`.
-    pub values: Option<Vec<f64>>,
-    /// First value.
-    pub from: f64,
-    /// Last value.
-    pub to: f64,
-    /// Number of values.
-    pub steps: usize,
-    /// Random initial states per value (besides continuation).
-    pub starts: u32,
-    /// Seed of the random initial states.
-    pub seed: u64,
-    /// Forward and backward continuation.
-    pub continuation: bool,
-    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
-    )]
-    pub threads: Option<usize>,
-    /// The steady-state search of every point.
-    #[serde(flatten)]
-    pub steady: SteadyRequest,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for BifurcationRequest {
-    fn default() -> Self {
-        BifurcationRequest {
-            param: SweepParam::Omega,
-            values: None,
-            from: 1.0,
-            to: 5.0,
-            steps: 400,
-            starts: 0,
-            seed: super::DEFAULT_SEED,
-            continuation: true,
-            threads: None,
-            steady: SteadyRequest::default(),
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `bifurcation`: the steady state over a grid of one parameter, continued forward and
+    /// backward and from seeded random starts.
+    pub struct BifurcationRequest {
+        /// The swept parameter: `omega` or `alpha1`..`alpha6` (or their names,
+        /// `tip-mass-ratio`, …).
+        pub param: SweepParam = SweepParam::Omega,
+        /// Explicit values instead of `from`, `to`, `steps`.
+        pub values: Option<Vec<f64>>,
+        /// First value.
+        pub from: f64 = 1.0,
+        /// Last value.
+        pub to: f64 = 5.0,
+        /// Number of values.
+        pub steps: usize = 400,
+        /// Random initial states per value (besides continuation).
+        pub starts: u32 = 0,
+        /// Seed of the random initial states.
+        pub seed: u64 = super::DEFAULT_SEED,
+        /// Forward and backward continuation.
+        pub continuation: bool = true,
+        /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+        constants(MAX_THREADS)
+        pub threads: Option<usize>,
+        /// The steady-state search of every point.
+        #[serde(flatten)]
+        pub steady: SteadyRequest,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 

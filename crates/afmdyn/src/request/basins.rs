@@ -14,79 +14,49 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
 pub use crate::report::basins::BasinArrays;
-use serde::{Deserialize, Serialize};
 
-/// `basins`: a basin map over two coordinates of the initial state at τ = 0.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct BasinsRequest {
-    /// x coordinate: `a1`…`aN`, `adot1`…`adotN`, `w` or `wdot` (the tip, set through mode 1).
-    pub x: String,
-    /// First x value (g0, or g0 per unit τ for a velocity).
-    pub x_from: f64,
-    /// Last x value.
-    pub x_to: f64,
-    /// Number of x values (columns).
-    pub x_steps: usize,
-    /// y coordinate, as `x`.
-    pub y: String,
-    /// First y value.
-    pub y_from: f64,
-    /// Last y value.
-    pub y_to: f64,
-    /// Number of y values (rows).
-    pub y_steps: usize,
-    /// The other coordinates of every start, 2N values (a1…aN, ȧ1…ȧN); `None`: the rest state.
-    pub base: Option<Vec<f64>>,
-    /// Relative distance to a periodic attractor's section point that counts as near, (0, 1].
-    pub near_tol: f64,
-    /// Side of the state-space cells of the recurrence test (g0; ×Ω for velocities), > 0.
-    pub cell: f64,
-    /// Consecutive returns in cells of one basin that decide a start (0: no recurrence test).
-    pub basin_hits: usize,
-    /// Returns tested before the steady-state search takes over.
-    pub discover_after: usize,
-    /// Stride of the first pass's coarse grid (0: automatic, 1: one pass).
-    pub stride: usize,
-    /// Relative tolerance for two steady states to be one attractor, > 0.
-    pub cluster_tol: f64,
-    /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
-    )]
-    pub threads: Option<usize>,
-    /// The steady-state search of a start the early tests leave undecided.
-    #[serde(flatten)]
-    pub steady: SteadyRequest,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for BasinsRequest {
-    fn default() -> Self {
-        BasinsRequest {
-            x: "a1".into(),
-            x_from: -0.6,
-            x_to: 0.6,
-            x_steps: 40,
-            y: "adot1".into(),
-            y_from: -1.2,
-            y_to: 1.2,
-            y_steps: 40,
-            base: None,
-            near_tol: DEFAULT_NEAR_TOL,
-            cell: DEFAULT_CELL,
-            basin_hits: DEFAULT_BASIN_HITS,
-            discover_after: DEFAULT_DISCOVER_AFTER,
-            stride: DEFAULT_STRIDE,
-            cluster_tol: super::DEFAULT_CLUSTER_TOL,
-            threads: None,
-            steady: SteadyRequest::default(),
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `basins`: a basin map over two coordinates of the initial state at τ = 0.
+    pub struct BasinsRequest {
+        /// x coordinate: `a1`…`aN`, `adot1`…`adotN`, `w` or `wdot` (the tip, set through mode 1).
+        pub x: String = "a1".into(),
+        /// First x value (g0, or g0 per unit τ for a velocity).
+        pub x_from: f64 = -0.6,
+        /// Last x value.
+        pub x_to: f64 = 0.6,
+        /// Number of x values (columns).
+        pub x_steps: usize = 40,
+        /// y coordinate, as `x`.
+        pub y: String = "adot1".into(),
+        /// First y value.
+        pub y_from: f64 = -1.2,
+        /// Last y value.
+        pub y_to: f64 = 1.2,
+        /// Number of y values (rows).
+        pub y_steps: usize = 40,
+        /// The other coordinates of every start, 2N values (a1…aN, ȧ1…ȧN); `None`: the rest state.
+        pub base: Option<Vec<f64>>,
+        /// Relative distance to a periodic attractor's section point that counts as near, (0, 1].
+        pub near_tol: f64 = DEFAULT_NEAR_TOL,
+        /// Side of the state-space cells of the recurrence test (g0; ×Ω for velocities), > 0.
+        pub cell: f64 = DEFAULT_CELL,
+        /// Consecutive returns in cells of one basin that decide a start (0: no recurrence test).
+        pub basin_hits: usize = DEFAULT_BASIN_HITS,
+        /// Returns tested before the steady-state search takes over.
+        pub discover_after: usize = DEFAULT_DISCOVER_AFTER,
+        /// Stride of the first pass's coarse grid (0: automatic, 1: one pass).
+        pub stride: usize = DEFAULT_STRIDE,
+        /// Relative tolerance for two steady states to be one attractor, > 0.
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
+        /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
+        constants(MAX_THREADS in super::limits)
+        pub threads: Option<usize>,
+        /// The steady-state search of a start the early tests leave undecided.
+        #[serde(flatten)]
+        pub steady: SteadyRequest,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 

@@ -9,49 +9,47 @@ use super::limits::Cost;
 use super::thermal::{check_thermal, temperature_warnings, DEFAULT_TEMPERATURE};
 use crate::analysis::calibration::Signal;
 use crate::error::SimError;
-use serde::{Deserialize, Serialize};
 
-/// `calibrate`: the measured spectrum (a CSV file `psd`, or the columns `frequency` and
-/// `spectral_density`), what it measures, the temperature, the bands of the peaks, and a force
-/// curve for the inverse optical lever sensitivity. Needs a probe (its modes, their correction
-/// factors, and for Sader's method its plan and fluid).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct CalibrateRequest {
-    /// A CSV file with the columns `frequency` (Hz, increasing) and `psd` (the one-sided power
-    /// spectral density, m²/Hz, or V²/Hz with `volts`), read through the bounded reader
-    /// (instead of the columns `frequency` and `spectral_density`).
-    pub psd: Option<String>,
-    /// The frequencies (Hz, > 0, increasing), when no `psd` file is given.
-    pub frequency: Vec<f64>,
-    /// The one-sided PSD at them (m²/Hz, or V²/Hz with `volts`; > 0), as many as `frequency`.
-    pub spectral_density: Vec<f64>,
-    /// What the spectrum measures: `apparent-deflection` (an optical lever's, the default) or
-    /// `deflection` (the tip's, an interferometer's).
-    pub signal: Option<Signal>,
-    /// Whether the PSD is the detector's, in V²/Hz: converted with `invols`, or with the
-    /// InvOLS of `force_curve`.
-    pub volts: bool,
-    /// The inverse optical lever sensitivity (m/V, > 0) that converts a PSD in V²/Hz.
-    pub invols: Option<f64>,
-    /// A force curve on a hard surface: a CSV with the columns `height` (m, the piezo height,
-    /// decreasing into the surface) and `deflection` (V), whose contact slope gives the InvOLS.
-    pub force_curve: Option<String>,
-    /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
-    /// value in °C?).
-    pub temperature: Option<f64>,
-    /// The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤
-    /// 1; default 1): the correction factors are the model's there.
-    pub spot: Option<f64>,
-    /// The number of peaks fitted, the modes from the first (1 to the probe's number of modes;
-    /// default every mode of the probe whose peak lies in the spectrum).
-    pub peaks: Option<usize>,
-    /// The frequency bands searched for the modes' peaks, a pair lo, hi (Hz) per mode from the
-    /// first: `[lo1, hi1, lo2, hi2, …]`; default from half to twice the probe's f_k, bounded by
-    /// the geometric means with the neighbouring modes.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    pub bands: Vec<f64>,
+request! {
+    /// `calibrate`: the measured spectrum (a CSV file `psd`, or the columns `frequency` and
+    /// `spectral_density`), what it measures, the temperature, the bands of the peaks, and a force
+    /// curve for the inverse optical lever sensitivity. Needs a probe (its modes, their correction
+    /// factors, and for Sader's method its plan and fluid).
+    pub struct CalibrateRequest {
+        /// A CSV file with the columns `frequency` (Hz, increasing) and `psd` (the one-sided power
+        /// spectral density, m²/Hz, or V²/Hz with `volts`), read through the bounded reader
+        /// (instead of the columns `frequency` and `spectral_density`).
+        pub psd: Option<String>,
+        /// The frequencies (Hz, > 0, increasing), when no `psd` file is given.
+        pub frequency: Vec<f64>,
+        /// The one-sided PSD at them (m²/Hz, or V²/Hz with `volts`; > 0), as many as `frequency`.
+        pub spectral_density: Vec<f64>,
+        /// What the spectrum measures: `apparent-deflection` (an optical lever's, the default) or
+        /// `deflection` (the tip's, an interferometer's).
+        pub signal: Option<Signal>,
+        /// Whether the PSD is the detector's, in V²/Hz: converted with `invols`, or with the
+        /// InvOLS of `force_curve`.
+        pub volts: bool,
+        /// The inverse optical lever sensitivity (m/V, > 0) that converts a PSD in V²/Hz.
+        pub invols: Option<f64>,
+        /// A force curve on a hard surface: a CSV with the columns `height` (m, the piezo height,
+        /// decreasing into the surface) and `deflection` (V), whose contact slope gives the InvOLS.
+        pub force_curve: Option<String>,
+        /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
+        /// value in °C?).
+        pub temperature: Option<f64>,
+        /// The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤
+        /// 1; default 1): the correction factors are the model's there.
+        pub spot: Option<f64>,
+        /// The number of peaks fitted, the modes from the first (1 to the probe's number of modes;
+        /// default every mode of the probe whose peak lies in the spectrum).
+        pub peaks: Option<usize>,
+        /// The frequency bands searched for the modes' peaks, a pair lo, hi (Hz) per mode from the
+        /// first: `[lo1, hi1, lo2, hi2, …]`; default from half to twice the probe's f_k, bounded by
+        /// the geometric means with the neighbouring modes.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub bands: Vec<f64>,
+    }
 }
 
 impl CalibrateRequest {

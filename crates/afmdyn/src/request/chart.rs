@@ -18,7 +18,6 @@ use crate::analysis::chart::{CellParams, ChartSpec};
 use crate::error::{in_range, SimError};
 use crate::params::Params;
 use crate::probe::Probe;
-use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 pub use crate::report::chart_layout::{ChartArrays, CSV_COLUMNS, CSV_HEADER};
@@ -36,100 +35,60 @@ pub const MAX_CHART_SLOTS: usize = 64;
 /// Largest number of drive periods of a λ₁ estimate.
 pub const MAX_CHART_LYAPUNOV_PERIODS: usize = 1_000_000;
 
-/// `chart`: period, λ₁, X_max, contacts and basin fractions of every attractor over a grid of
-/// two parameters.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ChartRequest {
-    /// The x parameter (columns): a real model parameter's name or alias (`-` read as `_`).
-    pub x: String,
-    /// First x value (in the parameter's unit: dimensionless, m for z_c, Hz for
-    /// drive_frequency).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
-    pub x_from: f64,
-    /// Last x value.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
-    pub x_to: f64,
-    /// Number of x values, ≥ 1.
-    pub x_steps: usize,
-    /// The y parameter (rows).
-    pub y: String,
-    /// First y value.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
-    pub y_from: f64,
-    /// Last y value.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
-    pub y_to: f64,
-    /// Number of y values, ≥ 1.
-    pub y_steps: usize,
-    /// Random starts per cell, 1..=[`MAX_CHART_STARTS`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CHART_STARTS": MAX_CHART_STARTS }))
-    )]
-    pub starts: u32,
-    /// Seed of the random starts.
-    pub seed: u64,
-    /// Cells per task (continuation runs along x within a tile), 1..=[`MAX_CHART_TILE`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CHART_TILE": MAX_CHART_TILE }))
-    )]
-    pub tile: usize,
-    /// Clustering tolerance of two steady states, > 0.
-    pub cluster_tol: f64,
-    /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none),
-    /// ≤ [`MAX_CHART_LYAPUNOV_PERIODS`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CHART_LYAPUNOV_PERIODS": MAX_CHART_LYAPUNOV_PERIODS }))
-    )]
-    pub lyapunov_periods: usize,
-    /// Attractor slots per cell in the arrays of the results ([`ChartArrays`]: `chart.nc`,
-    /// Python's dataset, the Dask store), 1..=[`MAX_CHART_SLOTS`]: a cell with more keeps its
-    /// first ones (most random starts first) there, and its `attractors` count tells how many
-    /// it has; the CSV and JSON list every one.
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_CHART_SLOTS": MAX_CHART_SLOTS }))
-    )]
-    pub max_attractors: usize,
-    /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
-    )]
-    pub threads: Option<usize>,
-    /// The steady-state search of every run.
-    #[serde(flatten)]
-    pub steady: SteadyRequest,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for ChartRequest {
-    fn default() -> Self {
-        ChartRequest {
-            x: "omega".into(),
-            x_from: 2.6,
-            x_to: 3.0,
-            x_steps: 9,
-            y: "drive_amplitude".into(),
-            y_from: 0.1,
-            y_to: 0.12,
-            y_steps: 2,
-            starts: 4,
-            seed: super::DEFAULT_SEED,
-            tile: 8,
-            cluster_tol: super::DEFAULT_CLUSTER_TOL,
-            lyapunov_periods: 500,
-            max_attractors: 8,
-            threads: None,
-            steady: SteadyRequest::default(),
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `chart`: period, λ₁, X_max, contacts and basin fractions of every attractor over a grid of
+    /// two parameters.
+    pub struct ChartRequest {
+        /// The x parameter (columns): a real model parameter's name or alias (`-` read as `_`).
+        pub x: String = "omega".into(),
+        /// First x value (in the parameter's unit: dimensionless, m for z_c, Hz for
+        /// drive_frequency).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
+        pub x_from: f64 = 2.6,
+        /// Last x value.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
+        pub x_to: f64 = 3.0,
+        /// Number of x values, ≥ 1.
+        pub x_steps: usize = 9,
+        /// The y parameter (rows).
+        pub y: String = "drive_amplitude".into(),
+        /// First y value.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
+        pub y_from: f64 = 0.1,
+        /// Last y value.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
+        pub y_to: f64 = 0.12,
+        /// Number of y values, ≥ 1.
+        pub y_steps: usize = 2,
+        /// Random starts per cell, 1..=[`MAX_CHART_STARTS`].
+        constants(MAX_CHART_STARTS)
+        pub starts: u32 = 4,
+        /// Seed of the random starts.
+        pub seed: u64 = super::DEFAULT_SEED,
+        /// Cells per task (continuation runs along x within a tile), 1..=[`MAX_CHART_TILE`].
+        constants(MAX_CHART_TILE)
+        pub tile: usize = 8,
+        /// Clustering tolerance of two steady states, > 0.
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
+        /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none),
+        /// ≤ [`MAX_CHART_LYAPUNOV_PERIODS`].
+        constants(MAX_CHART_LYAPUNOV_PERIODS)
+        pub lyapunov_periods: usize = 500,
+        /// Attractor slots per cell in the arrays of the results ([`ChartArrays`]: `chart.nc`,
+        /// Python's dataset, the Dask store), 1..=[`MAX_CHART_SLOTS`]: a cell with more keeps its
+        /// first ones (most random starts first) there, and its `attractors` count tells how many
+        /// it has; the CSV and JSON list every one.
+        constants(MAX_CHART_SLOTS)
+        pub max_attractors: usize = 8,
+        /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
+        constants(MAX_THREADS in super::limits)
+        pub threads: Option<usize>,
+        /// The steady-state search of every run.
+        #[serde(flatten)]
+        pub steady: SteadyRequest,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 

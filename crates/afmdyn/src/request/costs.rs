@@ -13,7 +13,7 @@
 //! integrates nothing (`fit` of a force curve, `reconstruct`) counts its elementary operations
 //! at [`OPERATION_WORK`] each.
 
-use super::limits::{Cost, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
+use super::limits::{Cost, GIB, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
 use crate::analysis::attractors::AttractorSpec;
 use crate::analysis::basins::BasinSpec;
 use crate::analysis::shooting::ShootingOptions;
@@ -81,7 +81,6 @@ pub(crate) fn check_cost_advising(
     memory_hint: &'static str,
     work_hint: &'static str,
 ) -> Result<(), SimError> {
-    const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
     // the size that would fit, for a cost that grows with the request's size
     let fits = |over: f64| {
         let percent = 100.0 / over;

@@ -12,68 +12,46 @@ use crate::analysis::stepped::{
 use crate::error::{within, SimError};
 use crate::model::CantileverModel;
 use crate::params::{Params, OMEGA_MAX, OMEGA_MIN};
-use serde::{Deserialize, Serialize};
 
-/// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
-/// Python keywords): the ends and the step in the front end's unit of the swept quantity (one
-/// dimensionless unit = `unit` of them: g₀ in m, or Hz per unit Ω), `None` for the command's
-/// default range; [`approach_request`] and
-/// [`resonance_request`] turn it into a
-/// [`SteppedSpec`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct CurveRequest {
-    /// First end of the swept quantity (front-end unit): the rest distance z_c where the
-    /// approach starts (m with a probe, else g₀; default 1.2 × the free amplitude A₀, the sum of
-    /// the components' under a multifrequency drive), or the start of the resonance band (Hz
-    /// with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k, 0.02)).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
-    pub from: Option<f64>,
-    /// Other end (front-end unit): z_c where the approach ends and the retract starts (default
-    /// 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
-    pub to: Option<f64>,
-    /// Grid step (front-end unit, that of `from` and `to`); excludes `points`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
-    pub step: Option<f64>,
-    /// Number of grid values, ends included, 2..=[`MAX_CURVE_POINTS`] (default
-    /// [`DEFAULT_CURVE_POINTS`]; a resonance curve with a probe takes more where a tenth of
-    /// the linewidth needs them ([`crate::request::curves::linewidth_points`])).
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = {
-            "MAX_CURVE_POINTS": MAX_CURVE_POINTS, "DEFAULT_CURVE_POINTS": DEFAULT_CURVE_POINTS
-        }))
-    )]
-    pub points: Option<usize>,
-    /// Continue the periodic-orbit branches.
-    pub branches: bool,
-    /// Tolerance of the adaptive integrator, in (0, 1e-3).
-    pub tolerance: f64,
-    /// Record one steady-state cycle per point of the first sweep with this many samples per
-    /// drive period (2..=10000; [`crate::analysis::traces`]); `None`: no traces.
-    pub traces: Option<usize>,
-}
-
-impl Default for CurveRequest {
+request! {
+    /// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
+    /// Python keywords): the ends and the step in the front end's unit of the swept quantity (one
+    /// dimensionless unit = `unit` of them: g₀ in m, or Hz per unit Ω), `None` for the command's
+    /// default range; [`approach_request`] and
+    /// [`resonance_request`] turn it into a
+    /// [`SteppedSpec`].
+    #[derive(Copy)]
+    pub struct CurveRequest {
+        /// First end of the swept quantity (front-end unit): the rest distance z_c where the
+        /// approach starts (m with a probe, else g₀; default 1.2 × the free amplitude A₀, the sum of
+        /// the components' under a multifrequency drive), or the start of the resonance band (Hz
+        /// with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k, 0.02)).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
+        pub from: Option<f64>,
+        /// Other end (front-end unit): z_c where the approach ends and the retract starts (default
+        /// 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
+        pub to: Option<f64>,
+        /// Grid step (front-end unit, that of `from` and `to`); excludes `points`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
+        pub step: Option<f64>,
+        /// Number of grid values, ends included, 2..=[`MAX_CURVE_POINTS`] (default
+        /// [`DEFAULT_CURVE_POINTS`]; a resonance curve with a probe takes more where a tenth of
+        /// the linewidth needs them ([`crate::request::curves::linewidth_points`])).
+        constants(MAX_CURVE_POINTS, DEFAULT_CURVE_POINTS)
+        pub points: Option<usize>,
+        /// Continue the periodic-orbit branches.
+        pub branches: bool = true,
+        /// Tolerance of the adaptive integrator, in (0, 1e-3).
+        pub tolerance: f64 = DEFAULT_TOLERANCE,
+        /// Record one steady-state cycle per point of the first sweep with this many samples per
+        /// drive period (2..=10000; [`crate::analysis::traces`]); `None`: no traces.
+        pub traces: Option<usize>,
+    }
     /// The defaults of `afmdyn approach` / `resonance` and the Python functions: the command's
     /// range, [`DEFAULT_CURVE_POINTS`] values, branches continued, `DEFAULT_TOLERANCE`.
-    fn default() -> Self {
-        CurveRequest {
-            from: None,
-            to: None,
-            step: None,
-            points: None,
-            branches: true,
-            tolerance: DEFAULT_TOLERANCE,
-            traces: None,
-        }
-    }
+    impl Default;
 }
-
-/// Bytes in a GiB.
-const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 /// The worst-case memory of the traces of a curve of `points` points at `samples` samples per
 /// drive period, in bytes: every trace over
@@ -171,7 +149,7 @@ impl CurveRequest {
                         "{} points × {n} samples per period × up to {} periods: up to {:.1} GiB",
                         spec.values.len(),
                         crate::analysis::traces::MAX_TRACE_PERIODS,
-                        bytes / GIB
+                        bytes / super::limits::GIB
                     ),
                     budget: "1 GiB".into(),
                     hint: "fewer points or fewer traces samples per period",

@@ -37,114 +37,91 @@ pub enum FitSegment {
     Whole,
 }
 
-/// `fit`: the force curve (a CSV file `data`, or the columns `height`, `force` and optionally
-/// `sigma` and `time`), the parameters fitted (`fit`, probe keys), the segment and the range of tip
-/// positions fitted.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct FitRequest {
-    /// A CSV file, read through the bounded reader (instead of the columns `height` and
-    /// `force`). A force
-    /// curve: the columns `height` (m, the piezo height, decreasing into the sample), `force`
-    /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation) and
-    /// `time` (s, strictly increasing; needed by the `sls` law). A
-    /// dynamic curve: `z` (m, the piezo position, in the order stepped) with `amplitude` (m)
-    /// and/or `phase` (deg) (AM), or `frequency_shift` (Hz) (FM, at the probe's free
-    /// amplitude), or `amplitude_2` (m) and/or `phase_2` (deg) (bimodal, a probe with a second
-    /// drive component), each with an optional `sigma_<column>`.
-    pub data: Option<String>,
-    /// The piezo heights (m), when no `data` file is given.
-    pub height: Vec<f64>,
-    /// The forces (N), as many as `height`.
-    pub force: Vec<f64>,
-    /// The forces' standard deviations (N, > 0), as many as `force`; without them the noise is
-    /// estimated from the residuals.
-    pub sigma: Option<Vec<f64>>,
-    /// The rows' times (s, strictly increasing), as many as `force`, when no `data` file is
-    /// given; needed by the `sls` law (its relaxation and creep), ignored by the others.
-    pub time: Vec<f64>,
-    /// The parameters fitted, by their probe keys: `sample.youngs_modulus`, `tip.radius`,
-    /// `contact_point`, `baseline`, and `sample.hamaker` (DMT) or `sample.adhesion_energy`
-    /// (JKR); of the `sls` law `sample.stiffness`, `sample.maxwell_stiffness`,
-    /// `sample.relaxation_time` (N/m, N/m, s), `contact_point` and `baseline`. The others are
-    /// held at the probe's values (contact point and baseline at 0, after the preprocessing).
-    /// Default `sample.youngs_modulus`, `contact_point` (for `sls`: its three, `contact_point`
-    /// and `baseline`). Of an AM, FM or bimodal curve: `sample.youngs_modulus`,
-    /// `sample.hamaker` (DMT), `sample.viscosity` (DMT and JKR; Kelvin–Voigt η, Pa s),
-    /// `sample.damping` (Hertz's damper, N s/m), `sample.adhesion_energy` (JKR, J/m²),
-    /// `tip.radius`, `drive.free_amplitude` (m),
-    /// `cantilever.quality_factor` (AM and bimodal curves without `[medium]`;
-    /// at resonance Q trades against the sample's E: fit it with E held) and `z_offset` (always
-    /// fitted); default `sample.youngs_modulus`, `sample.hamaker` (DMT) or
-    /// `sample.adhesion_energy` (JKR) and `z_offset`.
-    pub fit: Vec<String>,
-    /// The segment fitted: `approach`, `retract` or `whole`; default the approach, the whole
-    /// curve for the `sls` law.
-    pub segment: Option<FitSegment>,
-    /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
-    /// nanite's `range_x`; on a dynamic curve, of its piezo positions z); default the whole
-    /// segment.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub range: Option<[f64; 2]>,
-    /// The number of rows of the approach (the rest is the retract), as an instrument records
-    /// its segments (afmformats' `segment` column, which Python reads from an instrument
-    /// file); default up to the lowest piezo height, inclusive. 1 to the number of rows.
-    pub approach_rows: Option<usize>,
-    /// Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them,
-    /// the probe keys (sample, tip) before the contact point, baseline and z_offset (beyond,
-    /// and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off
-    /// for an AM curve, where every profile point is a refit of stepped approaches (on, each
-    /// side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each
-    /// started from its neighbour; a side that has not risen by then is reported flat).
-    pub profiles: Option<bool>,
-    /// The sample's thickness h (m, > 0) above a rigid substrate: the Hertz law's force is
-    /// corrected for the bottom effect (Dimitriadis et al., *Biophys. J.* 82 (2002) 2798 for
-    /// the paraboloid and the sphere; Garcia & Garcia, *Biophys. J.* 114 (2018) 2923 for the
-    /// cone, the pyramids and the flat punch, an incompressible sample, ν 0.45–0.5). Default
-    /// none: a sample infinitely thick.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub thickness: Option<f64>,
-    /// Whether the sample is bonded to the substrate (glued; the default, true) or free to
-    /// slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the
-    /// sphere only). Used with `thickness`.
-    pub bonded: Option<bool>,
-    /// The temperature T (K, > 0 and ≤ 1500) of a force curve's thermal σ: when the data carry
-    /// no `sigma`, each force's standard deviation is the lever's thermal force noise
-    /// σ_F = k √(⟨z*²⟩_B + n_d² B), ⟨z*²⟩_B the optical lever's mean-square deflection below
-    /// the `bandwidth` B from the probe's thermal spectrum (`afmdyn thermal`, each mode as its
-    /// oscillator) and n_d the `detector_noise`: the free lever's (in contact with a sample of
-    /// stiffness k_s the scatter about the fit grows to √(1 + k_s/k) times it, the lever and
-    /// the sample in parallel seen through the tip position computed from the deflection).
-    /// Default none: σ from the residuals.
-    pub temperature: Option<f64>,
-    /// The detection bandwidth B (Hz, > 0) of the thermal σ; default the Nyquist frequency of
-    /// the `time` column, 1/(2Δt).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    pub bandwidth: Option<f64>,
-    /// The detector's deflection noise floor n_d (m/√Hz, ≥ 0) of the thermal σ; default 0.
-    pub detector_noise: Option<f64>,
-}
-
-impl Default for FitRequest {
-    fn default() -> Self {
-        FitRequest {
-            data: None,
-            height: Vec::new(),
-            force: Vec::new(),
-            sigma: None,
-            time: Vec::new(),
-            fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into()],
-            segment: None,
-            range: None,
-            approach_rows: None,
-            profiles: None,
-            thickness: None,
-            bonded: None,
-            temperature: None,
-            bandwidth: None,
-            detector_noise: None,
-        }
+request! {
+    /// `fit`: the force curve (a CSV file `data`, or the columns `height`, `force` and optionally
+    /// `sigma` and `time`), the parameters fitted (`fit`, probe keys), the segment and the range of tip
+    /// positions fitted.
+    pub struct FitRequest {
+        /// A CSV file, read through the bounded reader (instead of the columns `height` and
+        /// `force`). A force
+        /// curve: the columns `height` (m, the piezo height, decreasing into the sample), `force`
+        /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation) and
+        /// `time` (s, strictly increasing; needed by the `sls` law). A
+        /// dynamic curve: `z` (m, the piezo position, in the order stepped) with `amplitude` (m)
+        /// and/or `phase` (deg) (AM), or `frequency_shift` (Hz) (FM, at the probe's free
+        /// amplitude), or `amplitude_2` (m) and/or `phase_2` (deg) (bimodal, a probe with a second
+        /// drive component), each with an optional `sigma_<column>`.
+        pub data: Option<String>,
+        /// The piezo heights (m), when no `data` file is given.
+        pub height: Vec<f64>,
+        /// The forces (N), as many as `height`.
+        pub force: Vec<f64>,
+        /// The forces' standard deviations (N, > 0), as many as `force`; without them the noise is
+        /// estimated from the residuals.
+        pub sigma: Option<Vec<f64>>,
+        /// The rows' times (s, strictly increasing), as many as `force`, when no `data` file is
+        /// given; needed by the `sls` law (its relaxation and creep), ignored by the others.
+        pub time: Vec<f64>,
+        /// The parameters fitted, by their probe keys: `sample.youngs_modulus`, `tip.radius`,
+        /// `contact_point`, `baseline`, and `sample.hamaker` (DMT) or `sample.adhesion_energy`
+        /// (JKR); of the `sls` law `sample.stiffness`, `sample.maxwell_stiffness`,
+        /// `sample.relaxation_time` (N/m, N/m, s), `contact_point` and `baseline`. The others are
+        /// held at the probe's values (contact point and baseline at 0, after the preprocessing).
+        /// Default `sample.youngs_modulus`, `contact_point` (for `sls`: its three, `contact_point`
+        /// and `baseline`). Of an AM, FM or bimodal curve: `sample.youngs_modulus`,
+        /// `sample.hamaker` (DMT), `sample.viscosity` (DMT and JKR; Kelvin–Voigt η, Pa s),
+        /// `sample.damping` (Hertz's damper, N s/m), `sample.adhesion_energy` (JKR, J/m²),
+        /// `tip.radius`, `drive.free_amplitude` (m),
+        /// `cantilever.quality_factor` (AM and bimodal curves without `[medium]`;
+        /// at resonance Q trades against the sample's E: fit it with E held) and `z_offset` (always
+        /// fitted); default `sample.youngs_modulus`, `sample.hamaker` (DMT) or
+        /// `sample.adhesion_energy` (JKR) and `z_offset`.
+        pub fit: Vec<String> = vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into()],
+        /// The segment fitted: `approach`, `retract` or `whole`; default the approach, the whole
+        /// curve for the `sls` law.
+        pub segment: Option<FitSegment>,
+        /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
+        /// nanite's `range_x`; on a dynamic curve, of its piezo positions z); default the whole
+        /// segment.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub range: Option<[f64; 2]>,
+        /// The number of rows of the approach (the rest is the retract), as an instrument records
+        /// its segments (afmformats' `segment` column, which Python reads from an instrument
+        /// file); default up to the lowest piezo height, inclusive. 1 to the number of rows.
+        pub approach_rows: Option<usize>,
+        /// Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them,
+        /// the probe keys (sample, tip) before the contact point, baseline and z_offset (beyond,
+        /// and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off
+        /// for an AM curve, where every profile point is a refit of stepped approaches (on, each
+        /// side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each
+        /// started from its neighbour; a side that has not risen by then is reported flat).
+        pub profiles: Option<bool>,
+        /// The sample's thickness h (m, > 0) above a rigid substrate: the Hertz law's force is
+        /// corrected for the bottom effect (Dimitriadis et al., *Biophys. J.* 82 (2002) 2798 for
+        /// the paraboloid and the sphere; Garcia & Garcia, *Biophys. J.* 114 (2018) 2923 for the
+        /// cone, the pyramids and the flat punch, an incompressible sample, ν 0.45–0.5). Default
+        /// none: a sample infinitely thick.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub thickness: Option<f64>,
+        /// Whether the sample is bonded to the substrate (glued; the default, true) or free to
+        /// slide on it (false: Dimitriadis et al.'s non-bonded series, of the paraboloid and the
+        /// sphere only). Used with `thickness`.
+        pub bonded: Option<bool>,
+        /// The temperature T (K, > 0 and ≤ 1500) of a force curve's thermal σ: when the data carry
+        /// no `sigma`, each force's standard deviation is the lever's thermal force noise
+        /// σ_F = k √(⟨z*²⟩_B + n_d² B), ⟨z*²⟩_B the optical lever's mean-square deflection below
+        /// the `bandwidth` B from the probe's thermal spectrum (`afmdyn thermal`, each mode as its
+        /// oscillator) and n_d the `detector_noise`: the free lever's (in contact with a sample of
+        /// stiffness k_s the scatter about the fit grows to √(1 + k_s/k) times it, the lever and
+        /// the sample in parallel seen through the tip position computed from the deflection).
+        /// Default none: σ from the residuals.
+        pub temperature: Option<f64>,
+        /// The detection bandwidth B (Hz, > 0) of the thermal σ; default the Nyquist frequency of
+        /// the `time` column, 1/(2Δt).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub bandwidth: Option<f64>,
+        /// The detector's deflection noise floor n_d (m/√Hz, ≥ 0) of the thermal σ; default 0.
+        pub detector_noise: Option<f64>,
     }
 }
 

@@ -19,10 +19,8 @@ use crate::analysis::fit::am_curve::{AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::profile::MAX_SECANT_STEPS;
 use crate::error::SimError;
 
-/// A refusal naming `name`.
-pub(crate) fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
-    SimError::out_of_range(name, value, allowed)
-}
+/// A refusal naming `name` (the force-curve fit's).
+pub(crate) use super::fit::bad;
 
 /// The AM and FM columns of a CSV file's `names` and `cols`, `None` without a `z` column.
 #[cfg(feature = "files")]

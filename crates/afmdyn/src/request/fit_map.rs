@@ -10,66 +10,49 @@ use super::fit_dynamic::fit_evaluations;
 use super::limits::Cost;
 use crate::analysis::fit::force_curve::{BASELINE, CONTACT_POINT, YOUNGS_MODULUS};
 use crate::error::SimError;
-use serde::{Deserialize, Serialize};
 
-/// `fit-map`: the map (`data`, a file), the parameters fitted at every curve (`fit`, probe
-/// keys), the segment and the range of tip positions fitted, and the worker threads.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct FitMapRequest {
-    /// The map, read through the bounded reader and streamed (one curve at a time): a
-    /// long-format CSV with the columns `x`, `y` (m, the curve's position), `height` (m, the
-    /// piezo height, decreasing into the sample), `force` (N, repulsion positive) and
-    /// optionally `segment` (0 approach, 1 retract) and `time` (s), a curve's rows
-    /// consecutive; or the NetCDF file `afmdyn.export_map` writes (from any map afmformats
-    /// reads, with each curve's grid index and spring constant).
-    pub data: Option<String>,
-    /// The parameters fitted at every curve, by their probe keys (as `fit`'s:
-    /// `sample.youngs_modulus`, `tip.radius`, `contact_point`, `baseline`, `sample.hamaker`
-    /// (DMT), `sample.adhesion_energy` (JKR)); the others held at the probe's values. Default
-    /// `sample.youngs_modulus`, `contact_point` and `baseline`, as nanite fits a map.
-    pub fit: Vec<String>,
-    /// The segment fitted: `approach` (the default), `retract` or `whole`.
-    pub segment: Option<FitSegment>,
-    /// The range of tip positions fitted [lo, hi] (m, relative to each curve's contact point
-    /// found by the deviation from the baseline, as nanite's `range_x`); default the whole
-    /// segment.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub range: Option<[f64; 2]>,
-    /// The sample's thickness h (m, > 0) above a rigid substrate, one value for every curve:
-    /// the Hertz law's force corrected for the bottom effect as `fit`'s `thickness`
-    /// (Dimitriadis et al. 2002; Garcia & Garcia 2018). Default none: a sample infinitely
-    /// thick. Not with `substrate_height`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub thickness: Option<f64>,
-    /// The substrate's piezo height (m, the `height` column's frame), read, for instance, on
-    /// a bare-glass pixel of the map's topography: each curve's thickness is its fitted
-    /// contact point's height above it (the curve refitted until its thickness moves by less
-    /// than 1e-4 of itself, from the contact point the deviation from the baseline finds). A
-    /// curve whose contact is not above it fails, naming it. Not with `thickness`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub substrate_height: Option<f64>,
-    /// Whether the sample is bonded to the substrate (the default, true) or free to slide on
-    /// it (false: the paraboloid's and the sphere's non-bonded series only), with
-    /// `thickness` or `substrate_height`.
-    pub bonded: Option<bool>,
-    /// Worker threads (default: all cores); the results do not depend on it.
-    pub threads: Option<usize>,
-}
-
-impl Default for FitMapRequest {
-    fn default() -> Self {
-        FitMapRequest {
-            data: None,
-            fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into(), BASELINE.into()],
-            segment: None,
-            range: None,
-            thickness: None,
-            substrate_height: None,
-            bonded: None,
-            threads: None,
-        }
+request! {
+    /// `fit-map`: the map (`data`, a file), the parameters fitted at every curve (`fit`, probe
+    /// keys), the segment and the range of tip positions fitted, and the worker threads.
+    pub struct FitMapRequest {
+        /// The map, read through the bounded reader and streamed (one curve at a time): a
+        /// long-format CSV with the columns `x`, `y` (m, the curve's position), `height` (m, the
+        /// piezo height, decreasing into the sample), `force` (N, repulsion positive) and
+        /// optionally `segment` (0 approach, 1 retract) and `time` (s), a curve's rows
+        /// consecutive; or the NetCDF file `afmdyn.export_map` writes (from any map afmformats
+        /// reads, with each curve's grid index and spring constant).
+        pub data: Option<String>,
+        /// The parameters fitted at every curve, by their probe keys (as `fit`'s:
+        /// `sample.youngs_modulus`, `tip.radius`, `contact_point`, `baseline`, `sample.hamaker`
+        /// (DMT), `sample.adhesion_energy` (JKR)); the others held at the probe's values. Default
+        /// `sample.youngs_modulus`, `contact_point` and `baseline`, as nanite fits a map.
+        pub fit: Vec<String> = vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into(), BASELINE.into()],
+        /// The segment fitted: `approach` (the default), `retract` or `whole`.
+        pub segment: Option<FitSegment>,
+        /// The range of tip positions fitted [lo, hi] (m, relative to each curve's contact point
+        /// found by the deviation from the baseline, as nanite's `range_x`); default the whole
+        /// segment.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub range: Option<[f64; 2]>,
+        /// The sample's thickness h (m, > 0) above a rigid substrate, one value for every curve:
+        /// the Hertz law's force corrected for the bottom effect as `fit`'s `thickness`
+        /// (Dimitriadis et al. 2002; Garcia & Garcia 2018). Default none: a sample infinitely
+        /// thick. Not with `substrate_height`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub thickness: Option<f64>,
+        /// The substrate's piezo height (m, the `height` column's frame), read, for instance, on
+        /// a bare-glass pixel of the map's topography: each curve's thickness is its fitted
+        /// contact point's height above it (the curve refitted until its thickness moves by less
+        /// than 1e-4 of itself, from the contact point the deviation from the baseline finds). A
+        /// curve whose contact is not above it fails, naming it. Not with `thickness`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub substrate_height: Option<f64>,
+        /// Whether the sample is bonded to the substrate (the default, true) or free to slide on
+        /// it (false: the paraboloid's and the sphere's non-bonded series only), with
+        /// `thickness` or `substrate_height`.
+        pub bonded: Option<bool>,
+        /// Worker threads (default: all cores); the results do not depend on it.
+        pub threads: Option<usize>,
     }
 }
 

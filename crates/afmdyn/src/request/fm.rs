@@ -14,57 +14,36 @@ use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
 use crate::error::SimError;
 use crate::report::CurveUnits;
-use serde::{Deserialize, Serialize};
 
-/// `fm`: an FM curve from `from` to `to` (z_c; m with a probe, else g₀) at the oscillation
-/// amplitude `amplitude`, tracking mode `mode`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct FmRequest {
-    /// The first-harmonic amplitude A the amplitude controller holds (m with a probe, else g₀),
-    /// > 0; default the probe's free amplitude A₀ (1 g₀).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub amplitude: Option<f64>,
-    /// The mode K (1-based) the PLL tracks; default 1.
-    pub mode: usize,
-    /// First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of
-    /// its value at `to` ([`crate::request::fm::default_from`]); 2A + a₀, the lower turning point at A, for the
-    /// laws without a force before contact).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub from: Option<f64>,
-    /// Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0 for
-    /// the laws without attraction).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub to: Option<f64>,
-    /// Step of z_c; excludes `points`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub step: Option<f64>,
-    /// Number of z_c values, ends included, 2..=[`crate::analysis::stepped::MAX_CURVE_POINTS`]
-    /// (default [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = {
-            "MAX_CURVE_POINTS": crate::analysis::stepped::MAX_CURVE_POINTS,
-            "DEFAULT_CURVE_POINTS": crate::analysis::stepped::DEFAULT_CURVE_POINTS
-        }))
-    )]
-    pub points: Option<usize>,
-    /// Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).
-    pub tolerance: f64,
-}
-
-impl Default for FmRequest {
-    fn default() -> Self {
-        FmRequest {
-            amplitude: None,
-            mode: 1,
-            from: None,
-            to: None,
-            step: None,
-            points: None,
-            tolerance: DEFAULT_LOOP_TOLERANCE,
-        }
+request! {
+    /// `fm`: an FM curve from `from` to `to` (z_c; m with a probe, else g₀) at the oscillation
+    /// amplitude `amplitude`, tracking mode `mode`.
+    pub struct FmRequest {
+        /// The first-harmonic amplitude A the amplitude controller holds (m with a probe, else g₀),
+        /// > 0; default the probe's free amplitude A₀ (1 g₀).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub amplitude: Option<f64>,
+        /// The mode K (1-based) the PLL tracks; default 1.
+        pub mode: usize = 1,
+        /// First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of
+        /// its value at `to` ([`crate::request::fm::default_from`]); 2A + a₀, the lower turning point at A, for the
+        /// laws without a force before contact).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub from: Option<f64>,
+        /// Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0 for
+        /// the laws without attraction).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub to: Option<f64>,
+        /// Step of z_c; excludes `points`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub step: Option<f64>,
+        /// Number of z_c values, ends included, 2..=[`crate::analysis::stepped::MAX_CURVE_POINTS`]
+        /// (default [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
+        constants(MAX_CURVE_POINTS in crate::analysis::stepped,
+                  DEFAULT_CURVE_POINTS in crate::analysis::stepped)
+        pub points: Option<usize>,
+        /// Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).
+        pub tolerance: f64 = DEFAULT_LOOP_TOLERANCE,
     }
 }
 

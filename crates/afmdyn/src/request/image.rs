@@ -189,7 +189,7 @@ impl ImageRequest {
                 needed: format!(
                     "{} × {lines} pixels at about {IMAGE_BYTES_PER_PIXEL} B each: {:.1} GiB",
                     self.pixels,
-                    bytes / (1024.0 * 1024.0 * 1024.0)
+                    bytes / super::limits::GIB
                 ),
                 budget: "1.1 GiB".into(),
                 hint: "fewer pixels or lines (up to about 1024 × 1024), or image the area in \
@@ -207,7 +207,7 @@ pub(crate) const IMAGE_BYTES_PER_PIXEL: f64 = 1000.0;
 /// The largest memory an image may take, estimated before the run: 1.1 GiB, about the traces'
 /// budget of a curve ([`super::limits::MAX_TRACE_BYTES`]), so that 1024 × 1024 pixels fit and
 /// 2048 × 2048 (which aborted on allocation) is refused naming the budget.
-pub(crate) const MAX_IMAGE_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_IMAGE_BYTES: f64 = 1.1 * super::limits::GIB;
 
 /// The background probe of an image under the probe file's table `probe_table`.
 ///

@@ -37,25 +37,24 @@ pub enum ImageFeedback {
     Pi,
 }
 
-/// `image`'s options beside its request: the imaging mode, the feedback, the worker threads and
-/// a setpoint study (module docs).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ImageOptions {
-    /// Imaging mode: `am` (amplitude-modulation tapping) or `peakforce` (off-resonance tapping
-    /// with an ideal peak-force feedback; a probe with `[drive] mode = "off-resonance"`): maps
-    /// of height, modulus_dmt, adhesion, deformation and dissipation.
-    pub mode: ImageMode,
-    /// Feedback: `ideal` (an operating point of the local material at every pixel) or `pi` (a
-    /// time-domain scan, trace and retrace, under a lock-in and a PI z controller).
-    pub feedback: ImageFeedback,
-    /// PI scan or PeakForce image: worker threads, one line per task (default: all cores).
-    pub threads: Option<usize>,
-    /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
-    /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
-    /// contrast inversion); "setpoint_study" in the document and two plots.
-    pub setpoint_study: Option<String>,
+request! {
+    /// `image`'s options beside its request: the imaging mode, the feedback, the worker threads and
+    /// a setpoint study (module docs).
+    pub struct ImageOptions {
+        /// Imaging mode: `am` (amplitude-modulation tapping) or `peakforce` (off-resonance tapping
+        /// with an ideal peak-force feedback; a probe with `[drive] mode = "off-resonance"`): maps
+        /// of height, modulus_dmt, adhesion, deformation and dissipation.
+        pub mode: ImageMode,
+        /// Feedback: `ideal` (an operating point of the local material at every pixel) or `pi` (a
+        /// time-domain scan, trace and retrace, under a lock-in and a PI z controller).
+        pub feedback: ImageFeedback,
+        /// PI scan or PeakForce image: worker threads, one line per task (default: all cores).
+        pub threads: Option<usize>,
+        /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
+        /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
+        /// contrast inversion); "setpoint_study" in the document and two plots.
+        pub setpoint_study: Option<String>,
+    }
 }
 
 impl ImageOptions {

@@ -33,40 +33,37 @@ pub(crate) const ENGAGE_LOOP_TIMES: f64 = 20.0;
 /// Loop time constants 1/K_I a pixel lasts at the default scan rate.
 pub const PIXEL_LOOP_TIMES: f64 = 5.0;
 
-/// The PI scan's settings as a front end takes them (SI; `None`: the lever's default, module
-/// docs).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct PiScan {
-    /// Scan rate (Hz): lines (trace and retrace) per second; `None`: a pixel lasts
-    /// [`PIXEL_LOOP_TIMES`] loop time constants 1/K_I.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "PIXEL_LOOP_TIMES": PIXEL_LOOP_TIMES }))
-    )]
-    pub scan_rate: Option<f64>,
-    /// The gains (K_P, K_I): K_P ≥ 0 (m/m), K_I > 0 (1/s); `None`: K_P = 0,
-    /// K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀ the lever's amplitude time constant and τ_L the
-    /// lock-in's.
-    pub gains: Option<(f64, f64)>,
-    /// The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range,
-    /// section `feedback`; [`crate::probe::ranges`]); outside 1 µs–0.1 s the image warns of a
-    /// likely unit slip. `None`: τ_c/4.
-    pub time_constant: Option<f64>,
-    /// The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside
-    /// 200–500 K it warns, a value in °C?); `None` (the default): no thermal noise. With one
-    /// the lines are integrated by the exact stochastic step of the linear law (the other
-    /// laws are refused), and the lock-in's amplitude and phase, the height and the error
-    /// images carry the noise the lever's thermal motion gives them at the lock-in's
-    /// bandwidth (the pixels' energy residual then holds the thermal force's work, which the
-    /// balance leaves out).
-    pub temperature: Option<f64>,
-    /// The seed of the thermal force (with `temperature`; default 0): each line draws from
-    /// streams of its own, so that an image is a function of its seed whatever the threads
-    /// or the executor.
-    pub seed: u64,
+request! {
+    /// The PI scan's settings as a front end takes them (SI; `None`: the lever's default, module
+    /// docs).
+    #[derive(Copy)]
+    pub struct PiScan {
+        /// Scan rate (Hz): lines (trace and retrace) per second; `None`: a pixel lasts
+        /// [`PIXEL_LOOP_TIMES`] loop time constants 1/K_I.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        constants(PIXEL_LOOP_TIMES)
+        pub scan_rate: Option<f64>,
+        /// The gains (K_P, K_I): K_P ≥ 0 (m/m), K_I > 0 (1/s); `None`: K_P = 0,
+        /// K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀ the lever's amplitude time constant and τ_L the
+        /// lock-in's.
+        pub gains: Option<(f64, f64)>,
+        /// The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range,
+        /// section `feedback`; [`crate::probe::ranges`]); outside 1 µs–0.1 s the image warns of a
+        /// likely unit slip. `None`: τ_c/4.
+        pub time_constant: Option<f64>,
+        /// The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside
+        /// 200–500 K it warns, a value in °C?); `None` (the default): no thermal noise. With one
+        /// the lines are integrated by the exact stochastic step of the linear law (the other
+        /// laws are refused), and the lock-in's amplitude and phase, the height and the error
+        /// images carry the noise the lever's thermal motion gives them at the lock-in's
+        /// bandwidth (the pixels' energy residual then holds the thermal force's work, which the
+        /// balance leaves out).
+        pub temperature: Option<f64>,
+        /// The seed of the thermal force (with `temperature`; default 0): each line draws from
+        /// streams of its own, so that an image is a function of its seed whatever the threads
+        /// or the executor.
+        pub seed: u64,
+    }
 }
 
 impl PiScan {

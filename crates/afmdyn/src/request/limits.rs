@@ -6,17 +6,19 @@
 /// the integration grid (the grid step of a period is ~1e-3 of it, and τ at 1e8 periods has an
 /// ulp of ~1e-8 of a period).
 pub const MAX_RUN_PERIODS: f64 = 1e8;
+/// Bytes in a GiB.
+pub(crate) const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 /// Largest time series streamed to files (`afmdyn simulate` writes timeseries.npy, and
 /// timeseries.csv on request), in bytes.
-pub(crate) const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_SERIES_BYTES: f64 = 16.0 * GIB;
 /// Largest time series held in memory (a Python call returns its arrays whole), in bytes: a
 /// quarter of this machine class's 24 GiB less room for the caller.
-pub(crate) const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * GIB;
 /// Largest memory the traces of a stepped curve (`approach`/`resonance --traces`) may take, in
 /// bytes, estimated before the run for the worst case (every trace over
 /// [`crate::analysis::traces::MAX_TRACE_PERIODS`] drive periods): 1 GiB, so that the traces and
 /// the copies a front end makes of them (files, NumPy arrays) stay within a few GiB.
-pub(crate) const MAX_TRACE_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_TRACE_BYTES: f64 = GIB;
 /// Bytes of one trace sample: deflection, distance and force, 8 bytes each.
 pub(crate) const TRACE_BYTES_PER_SAMPLE: f64 = 24.0;
 pub use crate::io::input::{MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};
@@ -66,7 +68,7 @@ pub struct Cost {
 /// of an image (`MAX_IMAGE_BYTES` of `crate::request::image`, where 2048 × 2048 pixels aborted
 /// on allocation) and about that of a curve's traces (`MAX_TRACE_BYTES`): what a request and
 /// the copies a front end makes of its result (files, NumPy arrays) hold within a few GiB.
-pub(crate) const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
+pub(crate) const MAX_REQUEST_BYTES: f64 = 1.1 * GIB;
 
 /// Largest work of a request, estimated before it runs, in mode-periods (drive periods
 /// integrated × modes): 1e11, about four days on one core at N = 20 (59 µs a drive period,

@@ -73,6 +73,55 @@ macro_rules! impl_request {
     };
 }
 
+/// A request declared once, each field with its default beside it: the struct with the derives
+/// and serde attributes every request shares (`Debug`, `Clone`, `PartialEq`, serde's
+/// `Serialize` and `Deserialize` with `default` and `deny_unknown_fields`, and with the
+/// `schema` feature `schemars::JsonSchema`), and its `impl Default`.
+///
+/// A field is `$(#[attr])* $(constants(NAME, …))? pub name: Type $(= default)?`: without
+/// `= default` it takes its type's `Default::default()`; `constants(NAME, …)` lists the
+/// constants its doc cites (limits, defaults) under the schema's `x-constants`
+/// (`{"NAME": NAME, …}`; `NAME in path` for one not in scope, `{"NAME": path::NAME}`). Attributes before `pub struct` follow
+/// the shared ones (the doc, `#[derive(Copy)]`, schemars attributes of the whole struct); a
+/// doc of `default` itself follows the struct, as `/// … impl Default;`.
+macro_rules! request {
+    (
+        $(#[$attr:meta])*
+        pub struct $name:ident {
+            $(
+                $(#[$fattr:meta])*
+                $(constants($($c:ident $(in $($m:ident)::+)?),+))?
+                pub $field:ident: $ty:ty $(= $default:expr)?
+            ),* $(,)?
+        }
+        $($(#[$dattr:meta])+ impl Default;)?
+    ) => {
+        #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+        #[serde(default, deny_unknown_fields)]
+        $(#[$attr])*
+        pub struct $name {
+            $(
+                $(#[$fattr])*
+                $(#[cfg_attr(
+                    feature = "schema",
+                    schemars(extend("x-constants" = { $(stringify!($c): $($($m::)+)? $c),+ }))
+                )])?
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            $($(#[$dattr])+)?
+            fn default() -> Self {
+                Self { $($field: request!(@default $($default)?),)* }
+            }
+        }
+    };
+    (@default) => { Default::default() };
+    (@default $default:expr) => { $default };
+}
+
 pub mod analyses;
 pub mod basins;
 pub mod calibrate;

@@ -21,29 +21,89 @@ use crate::error::SimError;
 use serde::de::{Deserialize, Deserializer};
 use serde_json::Value;
 
-/// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 20] = [
-    "modes",
-    "simulate",
-    "converge",
-    "attractors",
-    "global_continuation",
-    "orbit",
-    "continuation",
-    "lyapunov",
-    "observe",
-    "approach",
-    "bimodal",
-    "resonance",
-    "basins",
-    "fm",
-    "reconstruct",
-    "peakforce",
-    "fit",
-    "fit_map",
-    "thermal",
-    "calibrate",
-];
+/// The analyses by name, each once (`"name" => Variant(Request)`, in the order of [`NAMES`]; `own`
+/// where `each_request!` gives it its own arm): [`NAMES`], the variants of `Parsed` (and
+/// `reconstruct_document`'s, which has no name of its own there), [`parse`]'s arms and
+/// `each_request!`. Read entry by entry (`@read`, the variants of the common arm gathered), then
+/// written (`@write`, given the `$` that the written `each_request!` needs as `$d`).
+macro_rules! analyses {
+    (@read [$($all:tt)*] [$($plain:ident)*]) => {
+        analyses!(@write ($) [$($all)*] [$($plain)*]);
+    };
+    (@read [$($all:tt)*] [$($plain:ident)*] $name:literal => $v:ident($t:ty) own, $($rest:tt)*) => {
+        analyses!(@read [$($all)* ($name $v $t)] [$($plain)*] $($rest)*);
+    };
+    (@read [$($all:tt)*] [$($plain:ident)*] $name:literal => $v:ident($t:ty), $($rest:tt)*) => {
+        analyses!(@read [$($all)* ($name $v $t)] [$($plain)* $v] $($rest)*);
+    };
+    (@write ($d:tt) [$(($name:literal $v:ident $t:ty))*] [$($plain:ident)*]) => {
+        /// The names of the analyses [`parse`] knows.
+        pub const NAMES: [&str; [$($name),*].len()] = [$($name),*];
+
+        /// The request of each name.
+        #[derive(Debug, Clone)]
+        pub(crate) enum Parsed {
+            $(#[doc = concat!("`", $name, "`.")] $v($t),)*
+            /// `reconstruct_document`.
+            ReconstructDocument(FromDocument),
+        }
+
+        /// `$body` on the request `$r` of every variant of a [`NamedRequest`]'s `Parsed` but
+        /// `simulate` (its trajectory recorded whole in memory) and `reconstruct_document` (a
+        /// reconstruction from a document), which take their own arms: each request is an
+        /// analysis of its own.
+        macro_rules! each_request {
+            ($d named:expr, $d r:ident => $d body:expr, Simulate($d s:ident) => $d simulate:expr,
+             ReconstructDocument($d f:ident) => $d document:expr $d(,)?) => {
+                match $d named {
+                    $($crate::request::named::Parsed::$plain($d r) => $d body,)*
+                    $crate::request::named::Parsed::Simulate($d s) => $d simulate,
+                    $crate::request::named::Parsed::ReconstructDocument($d f) => $d document,
+                }
+            };
+        }
+
+        /// The request of analysis `name` from `d` ([`parse`]).
+        fn parse_named<'de, D: Deserializer<'de>>(
+            name: &str,
+            d: D,
+        ) -> Result<Option<NamedRequest>, D::Error> {
+            let named = match name {
+                $($name => Parsed::$v(<$t>::deserialize(d)?),)*
+                // the reconstruction of an fm or AM document (not in NAMES: no schema of its own)
+                "reconstruct_document" => Parsed::ReconstructDocument(FromDocument::deserialize(d)?),
+                _ => return Ok(None),
+            };
+            Ok(Some(NamedRequest(named)))
+        }
+    };
+    ($($entries:tt)*) => {
+        analyses!(@read [] [] $($entries)*);
+    };
+}
+
+analyses! {
+    "modes" => Modes(ModesRequest),
+    "simulate" => Simulate(SimulateRequest) own,
+    "converge" => Converge(ConvergeRequest),
+    "attractors" => Attractors(AttractorsRequest),
+    "global_continuation" => GlobalContinuation(GlobalContinuationRequest),
+    "orbit" => Orbit(OrbitRequest),
+    "continuation" => Continuation(ContinuationRequest),
+    "lyapunov" => Lyapunov(LyapunovRequest),
+    "observe" => Observe(ObserveRequest),
+    "approach" => Approach(ApproachRequest),
+    "bimodal" => Bimodal(Bimodal),
+    "resonance" => Resonance(ResonanceRequest),
+    "basins" => Basins(BasinsRequest),
+    "fm" => Fm(FmRequest),
+    "reconstruct" => Reconstruct(ReconstructRequest),
+    "peakforce" => PeakForce(PeakForceRequest),
+    "fit" => Fit(FitRequest),
+    "fit_map" => FitMap(super::FitMapRequest),
+    "thermal" => Thermal(super::ThermalRequest),
+    "calibrate" => Calibrate(super::CalibrateRequest),
+}
 
 /// An analysis request parsed by name ([`parse`]): the request of its name, as data. Its
 /// checks are here ([`NamedRequest::validate`]); running it to its outcome is the study
@@ -51,84 +111,6 @@ pub const NAMES: [&str; 20] = [
 #[derive(Debug, Clone)]
 pub struct NamedRequest(pub(crate) Parsed);
 
-/// The request of each name.
-#[derive(Debug, Clone)]
-pub(crate) enum Parsed {
-    /// `modes`.
-    Modes(ModesRequest),
-    /// `simulate`.
-    Simulate(SimulateRequest),
-    /// `converge`.
-    Converge(ConvergeRequest),
-    /// `attractors`.
-    Attractors(AttractorsRequest),
-    /// `global_continuation`.
-    GlobalContinuation(GlobalContinuationRequest),
-    /// `orbit`.
-    Orbit(OrbitRequest),
-    /// `continuation`.
-    Continuation(ContinuationRequest),
-    /// `lyapunov`.
-    Lyapunov(LyapunovRequest),
-    /// `observe`.
-    Observe(ObserveRequest),
-    /// `approach`.
-    Approach(ApproachRequest),
-    /// `bimodal`.
-    Bimodal(Bimodal),
-    /// `resonance`.
-    Resonance(ResonanceRequest),
-    /// `basins`.
-    Basins(BasinsRequest),
-    /// `fm`.
-    Fm(FmRequest),
-    /// `reconstruct`.
-    Reconstruct(ReconstructRequest),
-    /// `reconstruct_document`.
-    ReconstructDocument(FromDocument),
-    /// `peakforce`.
-    PeakForce(PeakForceRequest),
-    /// `fit`.
-    Fit(FitRequest),
-    /// `fit_map`.
-    FitMap(super::FitMapRequest),
-    /// `thermal`.
-    Thermal(super::ThermalRequest),
-    /// `calibrate`.
-    Calibrate(super::CalibrateRequest),
-}
-
-/// `$body` on the request `$r` of every variant of a [`NamedRequest`]'s `Parsed` but `simulate` (its
-/// trajectory recorded whole in memory) and `reconstruct_document` (a reconstruction from a
-/// document), which take their own arms: each request is an analysis of its own.
-macro_rules! each_request {
-    ($named:expr, $r:ident => $body:expr, Simulate($s:ident) => $simulate:expr,
-     ReconstructDocument($f:ident) => $document:expr $(,)?) => {
-        match $named {
-            $crate::request::named::Parsed::Modes($r) => $body,
-            $crate::request::named::Parsed::Converge($r) => $body,
-            $crate::request::named::Parsed::Attractors($r) => $body,
-            $crate::request::named::Parsed::GlobalContinuation($r) => $body,
-            $crate::request::named::Parsed::Orbit($r) => $body,
-            $crate::request::named::Parsed::Continuation($r) => $body,
-            $crate::request::named::Parsed::Lyapunov($r) => $body,
-            $crate::request::named::Parsed::Observe($r) => $body,
-            $crate::request::named::Parsed::Approach($r) => $body,
-            $crate::request::named::Parsed::Bimodal($r) => $body,
-            $crate::request::named::Parsed::Resonance($r) => $body,
-            $crate::request::named::Parsed::Basins($r) => $body,
-            $crate::request::named::Parsed::Fm($r) => $body,
-            $crate::request::named::Parsed::Reconstruct($r) => $body,
-            $crate::request::named::Parsed::PeakForce($r) => $body,
-            $crate::request::named::Parsed::Fit($r) => $body,
-            $crate::request::named::Parsed::FitMap($r) => $body,
-            $crate::request::named::Parsed::Thermal($r) => $body,
-            $crate::request::named::Parsed::Calibrate($r) => $body,
-            $crate::request::named::Parsed::Simulate($s) => $simulate,
-            $crate::request::named::Parsed::ReconstructDocument($f) => $document,
-        }
-    };
-}
 pub(crate) use each_request;
 
 impl NamedRequest {
@@ -170,39 +152,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
     name: &str,
     d: D,
 ) -> Result<Option<NamedRequest>, D::Error> {
-    use Parsed as N;
-    fn door<'de, A, D>(d: D, named: fn(A) -> Parsed) -> Result<Option<NamedRequest>, D::Error>
-    where
-        A: Deserialize<'de>,
-        D: Deserializer<'de>,
-    {
-        Ok(Some(NamedRequest(named(A::deserialize(d)?))))
-    }
-    match name {
-        "modes" => door(d, N::Modes),
-        "simulate" => door(d, N::Simulate),
-        "converge" => door(d, N::Converge),
-        "attractors" => door(d, N::Attractors),
-        "global_continuation" => door(d, N::GlobalContinuation),
-        "orbit" => door(d, N::Orbit),
-        "continuation" => door(d, N::Continuation),
-        "lyapunov" => door(d, N::Lyapunov),
-        "observe" => door(d, N::Observe),
-        "approach" => door(d, N::Approach),
-        "bimodal" => door(d, N::Bimodal),
-        "resonance" => door(d, N::Resonance),
-        "basins" => door(d, N::Basins),
-        "fm" => door(d, N::Fm),
-        "reconstruct" => door(d, N::Reconstruct),
-        // the reconstruction of an fm or AM document (not in NAMES: no schema of its own)
-        "reconstruct_document" => door(d, N::ReconstructDocument),
-        "peakforce" => door(d, N::PeakForce),
-        "fit" => door(d, N::Fit),
-        "fit_map" => door(d, N::FitMap),
-        "thermal" => door(d, N::Thermal),
-        "calibrate" => door(d, N::Calibrate),
-        _ => Ok(None),
-    }
+    parse_named(name, d)
 }
 
 /// The default request of analysis `name` as JSON (what a front end's keywords default to);

@@ -13,7 +13,6 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
-use serde::{Deserialize, Serialize};
 
 pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_POINTS};
 
@@ -30,53 +29,39 @@ pub(crate) fn first_natural_frequency(p: &Params) -> f64 {
     })
 }
 
-/// `peakforce`: one steady off-resonance tap at `z_c` (m with a probe, else g₀) or at the z_c
-/// whose peak force is `setpoint` (N with a probe, else F̃).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct PeakForceRequest {
-    /// The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance with the
-    /// lever at rest and the sample at the centre of its modulation; default the model's
-    /// (the probe's `[sample] z_c`, default A_m). Excludes `setpoint`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub z_c: Option<f64>,
-    /// The peak force the ideal feedback holds (N with a probe, else F̃), > 0: z_c is found so
-    /// that the steady tap's peak force equals it. Excludes `z_c`.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "force")))]
-    pub setpoint: Option<f64>,
-    /// Points of the reported cycle, in 2000..=1000000 (default 4096).
-    pub samples: usize,
-    /// The DMT fit's band: fractions [lo, hi] of the retract curve's force range from the
-    /// adhesion to the peak force (default [0.3, 0.9]).
-    pub fit_band: [f64; 2],
-    /// The instrument's low-pass filter on the measured force: the cut-off f_c (Hz with a
-    /// probe, else cycles per τ) of a causal second-order Butterworth filter
-    /// ([`crate::analysis::peakforce::low_pass_periodic`]) applied over the cycle to the force
-    /// the instrument measures, k × deflection; the curve then carries it filtered beside the
-    /// tip–sample force. `None` (default): no filter. f_c must lie below the Nyquist frequency
-    /// of the cycle's samples, `samples`/(2 × the modulation period).
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    pub filter_cutoff: Option<f64>,
-    /// A sweep in z_c or in the modulation frequency ([`PeakForceSweep`]): the channels as
-    /// curves over its values (the document's `sweep` block), each tap continued from the
-    /// previous tap's orbit; the single tap's blocks (`channels`, `cycle`, `curve`, …) are
-    /// those of the first value computed. A sweep in z_c excludes `z_c` and `setpoint`; with
-    /// `setpoint` a sweep in the modulation frequency holds the peak force at every value.
-    /// `None` (default): one tap.
-    pub sweep: Option<PeakForceSweep>,
-}
-
-impl Default for PeakForceRequest {
-    fn default() -> Self {
-        PeakForceRequest {
-            z_c: None,
-            setpoint: None,
-            samples: 4_096,
-            fit_band: [FIT_BAND.0, FIT_BAND.1],
-            filter_cutoff: None,
-            sweep: None,
-        }
+request! {
+    /// `peakforce`: one steady off-resonance tap at `z_c` (m with a probe, else g₀) or at the z_c
+    /// whose peak force is `setpoint` (N with a probe, else F̃).
+    pub struct PeakForceRequest {
+        /// The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance with the
+        /// lever at rest and the sample at the centre of its modulation; default the model's
+        /// (the probe's `[sample] z_c`, default A_m). Excludes `setpoint`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub z_c: Option<f64>,
+        /// The peak force the ideal feedback holds (N with a probe, else F̃), > 0: z_c is found so
+        /// that the steady tap's peak force equals it. Excludes `z_c`.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "force")))]
+        pub setpoint: Option<f64>,
+        /// Points of the reported cycle, in 2000..=1000000 (default 4096).
+        pub samples: usize = 4_096,
+        /// The DMT fit's band: fractions [lo, hi] of the retract curve's force range from the
+        /// adhesion to the peak force (default [0.3, 0.9]).
+        pub fit_band: [f64; 2] = [FIT_BAND.0, FIT_BAND.1],
+        /// The instrument's low-pass filter on the measured force: the cut-off f_c (Hz with a
+        /// probe, else cycles per τ) of a causal second-order Butterworth filter
+        /// ([`crate::analysis::peakforce::low_pass_periodic`]) applied over the cycle to the force
+        /// the instrument measures, k × deflection; the curve then carries it filtered beside the
+        /// tip–sample force. `None` (default): no filter. f_c must lie below the Nyquist frequency
+        /// of the cycle's samples, `samples`/(2 × the modulation period).
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub filter_cutoff: Option<f64>,
+        /// A sweep in z_c or in the modulation frequency ([`PeakForceSweep`]): the channels as
+        /// curves over its values (the document's `sweep` block), each tap continued from the
+        /// previous tap's orbit; the single tap's blocks (`channels`, `cycle`, `curve`, …) are
+        /// those of the first value computed. A sweep in z_c excludes `z_c` and `setpoint`; with
+        /// `setpoint` a sweep in the modulation frequency holds the peak force at every value.
+        /// `None` (default): one tap.
+        pub sweep: Option<PeakForceSweep>,
     }
 }
 

@@ -37,33 +37,32 @@ use crate::error::{number, SimError};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// `reconstruct`: a frequency-shift curve Δf against the distance of closest approach d (or
-/// the rest distance z_c, d = z_c − A), with the cantilever's k, f0 and A.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ReconstructRequest {
-    /// Distances of closest approach d (m), monotonic (either order); or give `z_c`.
-    pub distance: Option<Vec<f64>>,
-    /// Rest distances z_c (m) instead of `distance`: d = z_c − A (the lower turning point of
-    /// an oscillation of amplitude A without static deflection).
-    pub z_c: Option<Vec<f64>>,
-    /// Frequency shifts Δf = f − f0 (Hz), one per distance.
-    pub frequency_shift: Vec<f64>,
-    /// Spring constant k (N/m), > 0.
-    pub spring_constant: f64,
-    /// Free resonance frequency f0 (Hz), > 0.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    pub resonance_frequency: f64,
-    /// Oscillation amplitude A (m), > 0.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
-    pub amplitude: f64,
-    /// The model's force at each distance (N), when the curve came from a model (an `fm`
-    /// document's `curve.law_force`): reported beside the reconstruction for comparison.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub law_force: Option<Vec<f64>>,
-    /// The inversion: `"sader-jarvis"` (the default) or `"exact"` ([`FmInversion`]).
-    pub inversion: FmInversion,
+request! {
+    /// `reconstruct`: a frequency-shift curve Δf against the distance of closest approach d (or
+    /// the rest distance z_c, d = z_c − A), with the cantilever's k, f0 and A.
+    pub struct ReconstructRequest {
+        /// Distances of closest approach d (m), monotonic (either order); or give `z_c`.
+        pub distance: Option<Vec<f64>>,
+        /// Rest distances z_c (m) instead of `distance`: d = z_c − A (the lower turning point of
+        /// an oscillation of amplitude A without static deflection).
+        pub z_c: Option<Vec<f64>>,
+        /// Frequency shifts Δf = f − f0 (Hz), one per distance.
+        pub frequency_shift: Vec<f64>,
+        /// Spring constant k (N/m), > 0.
+        pub spring_constant: f64,
+        /// Free resonance frequency f0 (Hz), > 0.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub resonance_frequency: f64,
+        /// Oscillation amplitude A (m), > 0.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
+        pub amplitude: f64,
+        /// The model's force at each distance (N), when the curve came from a model (an `fm`
+        /// document's `curve.law_force`): reported beside the reconstruction for comparison.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub law_force: Option<Vec<f64>>,
+        /// The inversion: `"sader-jarvis"` (the default) or `"exact"` ([`FmInversion`]).
+        pub inversion: FmInversion,
+    }
 }
 
 /// How `reconstruct` inverts a frequency-shift curve.

@@ -30,7 +30,7 @@ use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::{self, CurveUnits};
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use serde_json::Value;
 
 /// The model of a run: the resolved parameters and the probe file they came from, if any
@@ -270,41 +270,35 @@ pub fn document<A: Analysis + ?Sized>(
     Ok(doc)
 }
 
-/// `approach`: the approach–retract curve over the rest distance z_c with its branches
-/// ([`crate::analysis::approach`]); `from`/`to`/`step` in metres with a probe, else in g₀.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[cfg_attr(feature = "schema", schemars(extend("x-swept" = "length")))]
-#[serde(default, deny_unknown_fields)]
-pub struct ApproachRequest {
-    /// The curve's range and options.
-    #[serde(flatten)]
-    pub curve: CurveRequest,
-    /// The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive A₁/A₀₁, of the
-    /// first component, the one the feedback holds): the document gains a `"setpoint"` block
-    /// with the operating points where the curve's amplitude equals it on each stable branch
-    /// ([`crate::analysis::setpoint`]).
-    pub setpoint: Option<f64>,
-    /// Measure every point by the time average of a multifrequency drive
-    /// ([`crate::analysis::stepped::average`]) instead of its periodic orbit; always so for a
-    /// quasi-periodic drive ([`Params::is_quasiperiodic`]). No branches then.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
-    pub average: bool,
-    /// Measure every point on the exact periodic orbit of the drive's common period even where
-    /// a two-frequency drive repeats only after more than
-    /// [`crate::analysis::stepped::torus::TORUS_PERIODS`] drive periods, whose points are
-    /// otherwise measured on invariant circles ([`crate::analysis::stepped::torus`]; with
-    /// branches and folds).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = {
-            "TORUS_PERIODS": crate::analysis::stepped::torus::TORUS_PERIODS
-        }))
-    )]
-    pub exact: bool,
+request! {
+    /// `approach`: the approach–retract curve over the rest distance z_c with its branches
+    /// ([`crate::analysis::approach`]); `from`/`to`/`step` in metres with a probe, else in g₀.
+    #[cfg_attr(feature = "schema", schemars(extend("x-swept" = "length")))]
+    pub struct ApproachRequest {
+        /// The curve's range and options.
+        #[serde(flatten)]
+        pub curve: CurveRequest,
+        /// The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive A₁/A₀₁, of the
+        /// first component, the one the feedback holds): the document gains a `"setpoint"` block
+        /// with the operating points where the curve's amplitude equals it on each stable branch
+        /// ([`crate::analysis::setpoint`]).
+        pub setpoint: Option<f64>,
+        /// Measure every point by the time average of a multifrequency drive
+        /// ([`crate::analysis::stepped::average`]) instead of its periodic orbit; always so for a
+        /// quasi-periodic drive ([`Params::is_quasiperiodic`]). No branches then.
+        #[serde(skip_serializing_if = "std::ops::Not::not")]
+        #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+        pub average: bool,
+        /// Measure every point on the exact periodic orbit of the drive's common period even where
+        /// a two-frequency drive repeats only after more than
+        /// [`crate::analysis::stepped::torus::TORUS_PERIODS`] drive periods, whose points are
+        /// otherwise measured on invariant circles ([`crate::analysis::stepped::torus`]; with
+        /// branches and folds).
+        #[serde(skip_serializing_if = "std::ops::Not::not")]
+        #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+        constants(TORUS_PERIODS in crate::analysis::stepped::torus)
+        pub exact: bool,
+    }
 }
 
 impl ApproachRequest {
@@ -343,26 +337,16 @@ impl ApproachRequest {
     }
 }
 
-/// `resonance`: the resonance curve near mode `mode` with its branches
-/// ([`crate::analysis::resonance`]); `from`/`to`/`step` in Hz with a probe, else in Ω.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[cfg_attr(feature = "schema", schemars(extend("x-swept" = "frequency")))]
-#[serde(default, deny_unknown_fields)]
-pub struct ResonanceRequest {
-    /// The mode k (1-based) whose resonance is swept.
-    pub mode: usize,
-    /// The curve's range and options.
-    #[serde(flatten)]
-    pub curve: CurveRequest,
-}
-
-impl Default for ResonanceRequest {
-    fn default() -> Self {
-        ResonanceRequest {
-            mode: 1,
-            curve: CurveRequest::default(),
-        }
+request! {
+    /// `resonance`: the resonance curve near mode `mode` with its branches
+    /// ([`crate::analysis::resonance`]); `from`/`to`/`step` in Hz with a probe, else in Ω.
+    #[cfg_attr(feature = "schema", schemars(extend("x-swept" = "frequency")))]
+    pub struct ResonanceRequest {
+        /// The mode k (1-based) whose resonance is swept.
+        pub mode: usize = 1,
+        /// The curve's range and options.
+        #[serde(flatten)]
+        pub curve: CurveRequest,
     }
 }
 

@@ -11,7 +11,6 @@ use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::probe::Probe;
 use nalgebra::DVector;
-use serde::{Deserialize, Serialize};
 
 /// Where a recorded time series goes, which sets its budget.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -24,61 +23,41 @@ pub enum SeriesStore {
     Nothing,
 }
 
-/// `simulate`: one trajectory recorded after a transient.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct SimulateRequest {
-    /// Drive periods recorded after the transient (> 0); default 50 when `tau_end` is not
-    /// given either.
-    pub periods: Option<f64>,
-    /// End time τ of the run, instead of `periods`.
-    pub tau_end: Option<f64>,
-    /// Drive periods discarded before recording, >= 0.
-    pub transient: f64,
-    /// The initial state (2N values); `None`: rest.
-    pub initial: Option<Vec<f64>>,
-    /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_SAMPLES_PER_PERIOD": MAX_SAMPLES_PER_PERIOD }))
-    )]
-    pub samples_per_period: usize,
-    /// Audit the energy balance of every drive period (`energy.csv`, the series' `energy_*`
-    /// variables and the summary's `energy_residual`, whose residual checks the integration);
-    /// off by default, as it takes a quarter to a half of the run's time
-    /// (`docs/performance/recording.md`).
-    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
-    pub energy_balance: bool,
-    /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
-    /// a value in °C?); `None` (the default): no thermal noise, the deterministic run. Each
-    /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
-    /// for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by
-    /// the exact stochastic step of the linear law (`crate::integrate::exact::noise`). Needs
-    /// the probe's SI units (`--probe`) and the linear law; not with `energy_balance`.
-    pub temperature: Option<f64>,
-    /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
-    /// a function of its seed, whatever the threads.
-    #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
-    pub seed: u64,
-    /// The integrator.
-    #[serde(flatten)]
-    pub integrator: IntegratorRequest,
-}
-
-impl Default for SimulateRequest {
-    fn default() -> Self {
-        SimulateRequest {
-            periods: None,
-            tau_end: None,
-            transient: 0.0,
-            initial: None,
-            samples_per_period: 200,
-            energy_balance: false,
-            temperature: None,
-            seed: 0,
-            integrator: IntegratorRequest::default(),
-        }
+request! {
+    /// `simulate`: one trajectory recorded after a transient.
+    pub struct SimulateRequest {
+        /// Drive periods recorded after the transient (> 0); default 50 when `tau_end` is not
+        /// given either.
+        pub periods: Option<f64>,
+        /// End time τ of the run, instead of `periods`.
+        pub tau_end: Option<f64>,
+        /// Drive periods discarded before recording, >= 0.
+        pub transient: f64 = 0.0,
+        /// The initial state (2N values); `None`: rest.
+        pub initial: Option<Vec<f64>>,
+        /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`].
+        constants(MAX_SAMPLES_PER_PERIOD)
+        pub samples_per_period: usize = 200,
+        /// Audit the energy balance of every drive period (`energy.csv`, the series' `energy_*`
+        /// variables and the summary's `energy_residual`, whose residual checks the integration);
+        /// off by default, as it takes a quarter to a half of the run's time
+        /// (`docs/performance/recording.md`).
+        #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+        pub energy_balance: bool = false,
+        /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
+        /// a value in °C?); `None` (the default): no thermal noise, the deterministic run. Each
+        /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
+        /// for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by
+        /// the exact stochastic step of the linear law (`crate::integrate::exact::noise`). Needs
+        /// the probe's SI units (`--probe`) and the linear law; not with `energy_balance`.
+        pub temperature: Option<f64>,
+        /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
+        /// a function of its seed, whatever the threads.
+        #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
+        pub seed: u64 = 0,
+        /// The integrator.
+        #[serde(flatten)]
+        pub integrator: IntegratorRequest,
     }
 }
 
@@ -179,7 +158,7 @@ impl SimulateRequest {
                     "{:.1} GB ({rows:.3e} samples × {columns} columns)",
                     bytes / 1e9
                 ),
-                budget: format!("{:.0} GiB", budget / (1024.0 * 1024.0 * 1024.0)),
+                budget: format!("{:.0} GiB", budget / super::limits::GIB),
                 hint: "lower periods or samples_per_period, or keep no time series",
             });
         }

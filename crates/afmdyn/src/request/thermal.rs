@@ -6,7 +6,6 @@ use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::error::SimError;
-use serde::{Deserialize, Serialize};
 
 /// The default temperature (K): a laboratory's 22 °C.
 pub const DEFAULT_TEMPERATURE: f64 = 295.0;
@@ -24,26 +23,25 @@ pub const DEFAULT_POINTS: usize = 4096;
 /// The largest number of frequencies (10⁷, 240 MB of spectrum).
 pub const MAX_POINTS: usize = 10_000_000;
 
-/// `thermal`: the temperature, the laser spot of the optical lever and the frequencies of the
-/// one-sided power spectral density (SI). Needs a probe.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct ThermalRequest {
-    /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
-    /// value in °C?).
-    pub temperature: Option<f64>,
-    /// The optical lever's laser spot ξ_s, a fraction of the lever's length from its base
-    /// (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.
-    pub spot: Option<f64>,
-    /// The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's
-    /// frequency, at least 3 f₀.
-    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
-    pub to: Option<f64>,
-    /// The number of frequencies, evenly spaced from to/points to `to` (1 to 10⁷; default
-    /// 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the
-    /// spectrum; each mode's share is exact whatever the spacing.
-    pub points: Option<usize>,
+request! {
+    /// `thermal`: the temperature, the laser spot of the optical lever and the frequencies of the
+    /// one-sided power spectral density (SI). Needs a probe.
+    pub struct ThermalRequest {
+        /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
+        /// value in °C?).
+        pub temperature: Option<f64>,
+        /// The optical lever's laser spot ξ_s, a fraction of the lever's length from its base
+        /// (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.
+        pub spot: Option<f64>,
+        /// The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's
+        /// frequency, at least 3 f₀.
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub to: Option<f64>,
+        /// The number of frequencies, evenly spaced from to/points to `to` (1 to 10⁷; default
+        /// 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the
+        /// spectrum; each mode's share is exact whatever the spacing.
+        pub points: Option<usize>,
+    }
 }
 
 impl ThermalRequest {

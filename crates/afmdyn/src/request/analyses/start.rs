@@ -4,39 +4,22 @@
 
 use super::*;
 
-/// The steady-state search of every analysis that starts from a transient.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct SteadyRequest {
-    /// Relative tolerance for two returns of the stroboscopic map to coincide, in
-    /// [1e-14, 1e-3].
-    pub tol: f64,
-    /// Cap on the transient, in drive periods, 1..=[`MAX_STEADY_PERIODS`]; `None` (default):
-    /// derived from the model's slowest free decay, six times the periods it takes to decay by
-    /// `tol` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of quality factor Q:
-    /// [`crate::analysis::steady::default_transient_cap`]).
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_STEADY_PERIODS": MAX_STEADY_PERIODS }))
-    )]
-    pub max_periods: Option<usize>,
-    /// Largest period searched, 1..=[`MAX_PERIOD`].
-    #[cfg_attr(
-        feature = "schema",
-        schemars(extend("x-constants" = { "MAX_PERIOD": MAX_PERIOD }))
-    )]
-    pub max_period: usize,
-}
-
-impl Default for SteadyRequest {
-    fn default() -> Self {
-        let d = SteadyOptions::default();
-        SteadyRequest {
-            tol: d.tol,
-            max_periods: d.max_periods,
-            max_period: d.max_period,
-        }
+request! {
+    /// The steady-state search of every analysis that starts from a transient.
+    #[derive(Copy)]
+    pub struct SteadyRequest {
+        /// Relative tolerance for two returns of the stroboscopic map to coincide, in
+        /// [1e-14, 1e-3].
+        pub tol: f64 = SteadyOptions::default().tol,
+        /// Cap on the transient, in drive periods, 1..=[`MAX_STEADY_PERIODS`]; `None` (default):
+        /// derived from the model's slowest free decay, six times the periods it takes to decay by
+        /// `tol` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of quality factor Q:
+        /// [`crate::analysis::steady::default_transient_cap`]).
+        constants(MAX_STEADY_PERIODS)
+        pub max_periods: Option<usize> = SteadyOptions::default().max_periods,
+        /// Largest period searched, 1..=[`MAX_PERIOD`].
+        constants(MAX_PERIOD)
+        pub max_period: usize = SteadyOptions::default().max_period,
     }
 }
 
@@ -57,30 +40,20 @@ impl SteadyRequest {
     }
 }
 
-/// The integrator of an analysis that lets the user choose it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct IntegratorRequest {
-    /// The time integrator: `auto` (the exact propagator for the linear law, the split
-    /// integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic
-    /// impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-    /// exact free flight cannot be built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or
-    /// `taylor`.
-    pub integrator: IntegratorKind,
-    /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
-    pub steps_per_period: Option<usize>,
-    /// Relative and absolute tolerance of the adaptive integrator.
-    pub tolerance: f64,
-}
-
-impl Default for IntegratorRequest {
-    fn default() -> Self {
-        IntegratorRequest {
-            integrator: IntegratorKind::Auto,
-            steps_per_period: None,
-            tolerance: 1e-12,
-        }
+request! {
+    /// The integrator of an analysis that lets the user choose it.
+    #[derive(Copy)]
+    pub struct IntegratorRequest {
+        /// The time integrator: `auto` (the exact propagator for the linear law, the split
+        /// integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic
+        /// impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
+        /// exact free flight cannot be built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or
+        /// `taylor`.
+        pub integrator: IntegratorKind = IntegratorKind::Auto,
+        /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
+        pub steps_per_period: Option<usize>,
+        /// Relative and absolute tolerance of the adaptive integrator.
+        pub tolerance: f64 = 1e-12,
     }
 }
 
@@ -167,16 +140,15 @@ pub fn initial_state(
     Ok(state)
 }
 
-/// Where an orbit analysis starts: a given state, or the steady state reached from rest.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(default, deny_unknown_fields)]
-pub struct StartRequest {
-    /// The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is; `None`: the
-    /// end of the steady state reached from rest.
-    pub initial: Option<Vec<f64>>,
-    /// The steady-state search from rest.
-    pub steady: SteadyRequest,
+request! {
+    /// Where an orbit analysis starts: a given state, or the steady state reached from rest.
+    pub struct StartRequest {
+        /// The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is; `None`: the
+        /// end of the steady state reached from rest.
+        pub initial: Option<Vec<f64>>,
+        /// The steady-state search from rest.
+        pub steady: SteadyRequest,
+    }
 }
 
 impl StartRequest {
