@@ -428,6 +428,16 @@ impl Sums {
     }
 }
 
+/// The integrator options of a line: the spec's; with a thermal force on a grid that holds
+/// the lock-in's samples (the stochastic step's drawn points).
+fn line_options(spec: &LineSpec) -> IntegratorOptions {
+    let mut opts = spec.integrator.clone();
+    if spec.thermal.is_some() {
+        opts.steps_per_period = holding_samples(opts.steps_per_period, spec.samples);
+    }
+    opts
+}
+
 /// Where a line engages, in pixels along it: the trace's first drive period,
 /// 0.5/`periods_per_pixel` (its material is the one [`Engage`] must be of).
 pub(crate) fn engage_position(spec: &LineSpec) -> f64 {
@@ -482,16 +492,7 @@ pub(crate) fn scan_line(
     // gap in place (`at_gap`)
     let mut kept: Vec<Option<Kept>> = spec.materials.iter().map(|_| None).collect();
     let materials = spec.materials.len() as u64;
-    // the exact stochastic step's grid holds the lock-in's samples
-    let holding = IntegratorOptions {
-        steps_per_period: holding_samples(spec.integrator.steps_per_period, spec.samples),
-        ..spec.integrator.clone()
-    };
-    let integrator = if spec.thermal.is_some() {
-        &holding
-    } else {
-        &spec.integrator
-    };
+    let integrator = line_options(spec);
     // one period at position s: returns the observables when `observe_it`
     let mut period_at = |s: f64,
                          observe_it: bool,
@@ -507,7 +508,7 @@ pub(crate) fn scan_line(
             mat,
             mat.alpha5_for_rest_distance(*piezo - h),
             &z,
-            integrator,
+            &integrator,
             (spec.thermal).map(|f| f.stream(line as u64 * materials + m as u64)),
         )?;
         let (raw, o) = if observe_it {
