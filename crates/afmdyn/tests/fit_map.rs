@@ -255,8 +255,7 @@ fn malformed_maps_are_refused_naming_the_file() {
     let path = dir.join("cut.nc");
     std::fs::write(&path, b"CDF\x01\x00\x00\x00\x05\x00\x00").unwrap();
     let msg = run(&request(&path, 1), &probe(), &Progress::default())
-        .err()
-        .expect("a cut NetCDF header was accepted")
+        .expect_err("a cut NetCDF header was accepted")
         .to_string();
     assert!(
         msg.contains("cut.nc")
