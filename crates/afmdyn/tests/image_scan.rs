@@ -515,7 +515,8 @@ fn water_linear() -> toml::Table {
 /// With a temperature the scan is a function of its seed: 1 and 2 threads give the same
 /// document, another seed another one; the thermal force moves every pixel (the heights of a
 /// flat sample spread, where without it they are one value), by far less than the free
-/// amplitude; a law other than the linear one is refused naming it.
+/// amplitude; its energy residual is not given; a law other than the linear one is refused
+/// naming it.
 #[test]
 fn a_thermal_scan_is_its_seeds() {
     let p = water_linear();
@@ -545,6 +546,16 @@ fn a_thermal_scan_is_its_seeds() {
         (h.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / h.len() as f64).sqrt()
     };
     let cold = run(None, 1, 1);
+    // the energy balance has no random work: its residual is not given under the thermal force
+    for dir in ["trace", "retrace"] {
+        assert!(one["artefacts"][dir]["energy_residual_max"].is_null());
+        assert!(
+            cold["artefacts"][dir]["energy_residual_max"]
+                .as_f64()
+                .unwrap()
+                < 1e-9
+        );
+    }
     let (hot, still) = (spread(&one), spread(&cold));
     println!("height spread: {hot:.4} nm with the thermal force, {still:.2e} nm without");
     assert!(still < 1e-6, "{still}");

@@ -254,7 +254,8 @@ pub struct ScanPixel {
     /// The per-mode energy balance of the last period (`observe`'s
     /// [`crate::analysis::observables::ModeBalance`]): the largest |residual| relative to the
     /// drive's work on its mode — the balance ΔE_j = drive − damping − sample − coupling holds
-    /// over any window, settled or not.
+    /// over any window, settled or not. NaN under a thermal force, whose work the balance
+    /// leaves out.
     pub energy_residual: f64,
 }
 
@@ -419,11 +420,12 @@ impl Sums {
                 && o.impacts_per_period == 0.0
                 && 2.0 * self.last > spec.setpoint + spec.free_amplitude,
             saturated: self.saturated,
-            energy_residual: o
-                .mode_balance
-                .iter()
-                .map(|b| b.residual.abs() / b.drive.abs().max(f64::MIN_POSITIVE))
-                .fold(0.0, f64::max),
+            energy_residual: match spec.thermal {
+                Some(_) => f64::NAN,
+                None => (o.mode_balance.iter())
+                    .map(|b| b.residual.abs() / b.drive.abs().max(f64::MIN_POSITIVE))
+                    .fold(0.0, f64::max),
+            },
         }
     }
 }

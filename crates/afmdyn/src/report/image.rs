@@ -229,7 +229,7 @@ pub struct Artefacts {
     /// Drive periods at the controller's output limit.
     pub saturated_periods: usize,
     /// The largest per-mode energy-balance residual of a pixel's last period, relative to the
-    /// drive's work ([`ScanPixel::energy_residual`]).
+    /// drive's work ([`ScanPixel::energy_residual`]); NaN (null in JSON) under a thermal force.
     pub energy_residual_max: f64,
 }
 
@@ -361,7 +361,10 @@ impl PiImage {
             tracking_error_rms: (err_sq / all).sqrt(),
             lost_contact_pixels: lost,
             saturated_periods: sat,
-            energy_residual_max: residual,
+            energy_residual_max: match self.settings.temperature {
+                Some(_) => f64::NAN,
+                None => residual,
+            },
         }
     }
 

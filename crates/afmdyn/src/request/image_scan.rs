@@ -56,8 +56,8 @@ request! {
         /// the lines are integrated by the exact stochastic step of the linear law (the other
         /// laws are refused), and the lock-in's amplitude and phase, the height and the error
         /// images carry the noise the lever's thermal motion gives them at the lock-in's
-        /// bandwidth (the pixels' energy residual then holds the thermal force's work, which the
-        /// balance leaves out).
+        /// bandwidth (the pixels' energy residual is then not given: the balance leaves the
+        /// thermal force's work out).
         pub temperature: Option<f64>,
         /// The seed of the thermal force (with `temperature`; default 0): each line draws from
         /// streams of its own, so that an image is a function of its seed whatever the threads
