@@ -106,13 +106,7 @@ impl ThermalForce {
 /// step has its drawn points (a sample between them is drawn from the bridge).
 pub(crate) fn holding_samples(steps: usize, samples: usize) -> usize {
     let (a, s) = (steps.max(1), samples.max(1));
-    let gcd = |mut x: usize, mut y: usize| {
-        while y != 0 {
-            (x, y) = (y, x % y);
-        }
-        x
-    };
-    a / gcd(a, s) * s
+    a / crate::params::gcd(a as u64, s as u64) as usize * s
 }
 
 /// Whether the exact stochastic step can integrate `law`: the piecewise-linear law only.
@@ -471,7 +465,6 @@ impl ThermalExact {
         Self::sign(r) * self.model().v_t_at(scm, [w, 0.0, 0.0])[0]
     }
 
-    /// τ of ladder position (j, i).
     /// How near to a time `t` a lattice point is taken for it: 1e-9 h, or [`ROUNDING_ULPS`]
     /// ulps of `t` where they are more.
     fn slack(&self, t: f64) -> f64 {
@@ -485,6 +478,7 @@ impl ThermalExact {
         t <= tau_max + self.slack(tau_max)
     }
 
+    /// τ of ladder position (j, i).
     fn lattice_tau(&self, (j, i): (i64, u64)) -> f64 {
         self.det.grid.tau(j) + i as f64 * self.det.grid.h / (1u64 << LEVELS) as f64
     }

@@ -346,6 +346,12 @@ pub(crate) fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -
         u.value(st.pixel_time, "s"),
         st.engage_periods
     ));
+    if let (Some(t), Some(seed)) = (st.temperature, st.seed) {
+        s.line(format!(
+            "  thermal noise at {} K (seed {seed}): the lever's thermal force on every line",
+            number(t)
+        ));
+    }
     for (name, art) in ["trace", "retrace"].iter().zip(img.artefacts) {
         s.line(format!(
             "  {name}: height error against the ideal image RMS {}, largest {}; overshoot {}; \
