@@ -180,7 +180,7 @@ pub struct SimulateFlags {
     #[arg(long, default_value = "0", help = "The seed of the thermal force's random stream (with --temperature; default 0): a run is a function of its seed, whatever the threads.")]
     pub seed: u64,
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise, the deterministic run. Each mode's equation then carries the white force the fluctuation–dissipation theorem gives for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by the exact stochastic step of the linear law (crate::integrate::exact::noise). Needs the probe's SI units (--probe) and the linear law; not with --energy-balance.")]
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise, the deterministic run. Each mode's equation then carries the white force the fluctuation–dissipation theorem gives for its damping (the lever's, the medium's, in contact the linear law's dashpot), advanced by the exact stochastic step of the linear law, or the exponential Euler step of Hertz, DMT and the electrostatic law (crate::integrate::exact::noise). Needs the probe's SI units (--probe); the laws with memory (JKR, capillary, SLS, impact) are refused; not with --energy-balance or a multifrequency drive.")]
     pub temperature: Option<f64>,
     /// The flags of the nested `integrator`.
     #[command(flatten)]

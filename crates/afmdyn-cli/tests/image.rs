@@ -129,18 +129,6 @@ fn bad_input_exits_2_naming_the_field() {
             ],
             "temperature = 0",
         ),
-        // the DMT law of this probe: the thermal force is the linear law's
-        (
-            vec![
-                "--setpoint",
-                "0.7",
-                "--feedback",
-                "pi",
-                "--temperature",
-                "295",
-            ],
-            "dmt",
-        ),
         (
             vec!["--setpoint", "0.7", "--feedback", "pi", "--gains", "-1,10"],
             "gains",
@@ -189,6 +177,36 @@ fn bad_input_exits_2_naming_the_field() {
             "{err}"
         );
     }
+    // a JKR stripe: a law with memory has no stochastic step (the thermal force is the linear
+    // law's and the memoryless laws'), refused naming it before any curve runs
+    let jkr = dir.path().join("jkr.toml");
+    std::fs::write(
+        &jkr,
+        "size = [1e-6, 0]\n[[domain]]\nname = \"j\"\nx = [3e-7, 5e-7]\n[domain.sample]\n\
+         law = \"jkr\"\nyoungs_modulus = 4e9\npoisson_ratio = 0.33\nadhesion_energy = 0.05\n",
+    )
+    .unwrap();
+    let out = afmdyn(&[
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        jkr.to_str().unwrap(),
+        "--setpoint",
+        "0.7",
+        "--feedback",
+        "pi",
+        "--temperature",
+        "295",
+        "--out",
+        d,
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("jkr") && err.trim().lines().count() == 1,
+        "{err}"
+    );
     let out = afmdyn(&[
         "image",
         "--probe",

@@ -3,9 +3,10 @@
 //!
 //! And the thermally driven free lever's cost per period (issue 79's aim: ≤ 2× the
 //! deterministic propagator's): the paper's default lever (N = 3 and 10) with the sample out of
-//! reach (α5 = 50), 100 periods on the same grid (the exact propagator's, 16 steps per period
-//! at least), by the deterministic exact propagator and by the exact stochastic step
-//! (`ThermalExact`, k_B T = 10⁻⁴ in the model's energy unit).
+//! reach (α5 = 50), 100 periods (the exact propagator's grid, 16 steps per period at least), by
+//! the deterministic exact propagator and by the exact stochastic step (`ThermalExact`,
+//! k_B T = 10⁻⁴ in the model's energy unit) holding one point per period, the stroboscopic
+//! section's (free flight between them).
 //!
 //! Run with `cargo bench -p afmdyn --bench thermal`.
 
@@ -67,7 +68,10 @@ fn free_lever(c: &mut Criterion) {
                 black_box(det.state()[0])
             })
         });
-        let mut th = ThermalExact::new(&m, &opts, ThermalForce::new(1e-4, 7)).unwrap();
+        // one held point per period (the stroboscopic section's): free flight between them
+        let mut th = ThermalExact::new(&m, &opts, ThermalForce::new(1e-4, 7))
+            .unwrap()
+            .holding(1);
         // (scripts/perf-thermal.sh reads the grid from this line)
         eprintln!("N = {n}: {} grid steps per period", th.steps_per_period());
         g.bench_function(format!("thermal N={n}"), |b| {

@@ -21,7 +21,7 @@
 //! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once the next bounce
 //! would rise less than `STICK_HEIGHT_TOLERANCES` guard tolerances while λ > 0.
 
-use crate::contact::{ContactLaw, PreparedLaw, TipSample, TipSampleLaw, Zener};
+use crate::contact::{ContactLaw, ForceEval, PreparedLaw, TipSample, TipSampleLaw, Zener};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::Galerkin;
 use crate::params::{Params, SweepParam};
@@ -463,6 +463,21 @@ impl CantileverModel {
             let (v, vd) = v_t();
             self.law.force(contact, -v, -vd).force
         }
+    }
+
+    /// F_c with its partials ∂F_c/∂δ, ∂F_c/∂δ̇ in region `r` at (sin Ωτ, cos Ωτ) = `sc` of a
+    /// law without memory (a force of the state; `z: [f64; 2N]`): zero outside contact for a
+    /// law that does not act there. (The thermal step's frozen force and its contact rate,
+    /// `crate::integrate::exact::noise`.)
+    pub(crate) fn tip_force_eval(&self, r: Region, sc: (f64, f64), z: &[f64]) -> ForceEval {
+        let contact = r == Region::Contact;
+        if !contact && !self.law.acts_outside() {
+            return ForceEval::default();
+        }
+        let n = self.modes();
+        let w = [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0];
+        let [v, vd, _] = self.v_t_at(sc, w);
+        self.law.force(contact, -v, -vd)
     }
 
     /// ∂ż/∂z at (τ, z) in region r into `jac` (2N×2N): A_I plus the rank-one tip-force term

@@ -103,9 +103,11 @@ def simulate(
             200–500 K it warns, a value in °C?); ``None`` (the default): no thermal noise,
             the deterministic run. Each mode's equation then carries the white force the
             fluctuation–dissipation theorem gives for its damping (the lever's, the
-            medium's, in contact the sample's dashpot), advanced by the exact stochastic
-            step of the linear law (``crate::integrate::exact::noise``). Needs the probe's
-            SI units (``--probe``) and the linear law; not with ``energy_balance``.
+            medium's, in contact the linear law's dashpot), advanced by the exact stochastic
+            step of the linear law, or the exponential Euler step of Hertz, DMT and the
+            electrostatic law (``crate::integrate::exact::noise``). Needs the probe's SI
+            units (``--probe``); the laws with memory (JKR, capillary, SLS, impact) are
+            refused; not with ``energy_balance`` or a multifrequency drive.
         tolerance: Relative and absolute tolerance of the adaptive integrator.
         transient: Drive periods discarded before recording, >= 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a

@@ -47,9 +47,11 @@ request! {
         /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
         /// a value in °C?); `None` (the default): no thermal noise, the deterministic run. Each
         /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
-        /// for its damping (the lever's, the medium's, in contact the sample's dashpot), advanced by
-        /// the exact stochastic step of the linear law (`crate::integrate::exact::noise`). Needs
-        /// the probe's SI units (`--probe`) and the linear law; not with `energy_balance`.
+        /// for its damping (the lever's, the medium's, in contact the linear law's dashpot),
+        /// advanced by the exact stochastic step of the linear law, or the exponential Euler step
+        /// of Hertz, DMT and the electrostatic law (`crate::integrate::exact::noise`). Needs the
+        /// probe's SI units (`--probe`); the laws with memory (JKR, capillary, SLS, impact) are
+        /// refused; not with `energy_balance` or a multifrequency drive.
         pub temperature: Option<f64>,
         /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
         /// a function of its seed, whatever the threads.
@@ -210,7 +212,7 @@ impl SimulateRequest {
 
     /// The integrator of the run of `model` from `z0` at τ = 0: [`crate::integrate::build`]'s,
     /// or with a temperature the exact stochastic step ([`ThermalExact`]) on a grid that is a
-    /// multiple of the samples per period (the samples are its points).
+    /// multiple of the samples per period, holding them (the samples are its drawn points).
     ///
     /// # Errors
     /// As [`SimulateRequest::thermal`], [`crate::integrate::build`] and [`ThermalExact::new`];
@@ -234,7 +236,7 @@ impl SimulateRequest {
             ));
         }
         opts.steps_per_period = holding_samples(opts.steps_per_period, self.samples_per_period);
-        let mut it = ThermalExact::new(model, &opts, force)?;
+        let mut it = ThermalExact::new(model, &opts, force)?.holding(self.samples_per_period);
         it.reset(0.0, z0)?;
         Ok(Box::new(it))
     }
