@@ -343,10 +343,8 @@ request! {
     #[cfg_attr(feature = "schema", schemars(extend("x-swept" = "frequency")))]
     pub struct ResonanceRequest {
         /// The mode k (1-based) whose resonance is swept.
-        pub mode: usize = 1,
-        /// The curve's range and options.
-        #[serde(flatten)]
-        pub curve: CurveRequest,
+        pub mode: usize = 1;
+        flatten curve: CurveRequest,
     }
 }
 

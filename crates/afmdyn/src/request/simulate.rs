@@ -54,10 +54,8 @@ request! {
         /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
         /// a function of its seed, whatever the threads.
         #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
-        pub seed: u64 = 0,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub seed: u64 = 0;
+        flatten integrator: IntegratorRequest,
     }
 }
 
