@@ -3,6 +3,7 @@
 //! ranges and its declared cost ([`crate::analysis::thermal`] computes it).
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
+use super::fit::bad;
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::error::SimError;
@@ -139,10 +140,6 @@ pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), S
         ));
     }
     Ok(())
-}
-
-fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimError {
-    SimError::out_of_range(name, value.to_string(), allowed)
 }
 
 impl_request! {
