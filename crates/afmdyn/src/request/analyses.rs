@@ -320,8 +320,7 @@ impl ConvergeRequest {
 }
 
 pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
-    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)?;
-    Ok(())
+    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)
 }
 
 request! {
@@ -582,17 +581,12 @@ pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Val
         "steps_per_period": spec.integrator.steps_per_period,
         "tolerance": spec.integrator.tolerance,
     });
-    if let Some(map) = doc.as_object_mut() {
-        match &request.values {
-            Some(v) => {
-                map.insert("values".into(), json!(v));
-            }
-            None => {
-                map.insert("from".into(), json!(request.from));
-                map.insert("to".into(), json!(request.to));
-                map.insert("steps".into(), json!(request.steps));
-            }
-        }
+    let range = match &request.values {
+        Some(v) => json!({ "values": v }),
+        None => json!({ "from": request.from, "to": request.to, "steps": request.steps }),
+    };
+    if let (Some(map), Value::Object(range)) = (doc.as_object_mut(), range) {
+        map.extend(range);
     }
     doc
 }

@@ -332,9 +332,7 @@ impl FitRequest {
         }
         Ok(law)
     }
-}
 
-impl FitRequest {
     /// `range`, when given, is two finite positions lo < hi.
     ///
     /// # Errors
@@ -345,6 +343,49 @@ impl FitRequest {
                 "range",
                 format!("[{lo}, {hi}]"),
                 "must be two finite positions lo < hi (m)",
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The thermal σ's options: T in (0, 1500] K, B > 0, n_d ≥ 0, neither of the latter
+    /// without T, and a probe that gives the lever's resonance and Q (not a quasi-static
+    /// read's stand-ins).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option.
+    fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
+        let Some(t) = self.temperature else {
+            return match (self.bandwidth, self.detector_noise) {
+                (None, None) => Ok(()),
+                (b, _) => Err(bad(
+                    if b.is_some() {
+                        "bandwidth"
+                    } else {
+                        "detector_noise"
+                    },
+                    "given without a temperature",
+                    "the bandwidth and the detector noise set the thermal σ: give the temperature",
+                )),
+            };
+        };
+        super::thermal::check_temperature(t)?;
+        let number = crate::error::number;
+        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
+            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));
+        }
+        if let Some(n) = self
+            .detector_noise
+            .filter(|n| !(n.is_finite() && *n >= 0.0))
+        {
+            return Err(bad("detector_noise", number(n), "finite and ≥ 0 (m/√Hz)"));
+        }
+        match model.probe.as_ref().map(|p| &p.assumed) {
+            Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(
+                "temperature",
+                number(t),
+                "the thermal σ needs the lever's modes: give [cantilever] resonance_frequency \
+                 and quality_factor in the probe",
             )),
             _ => Ok(()),
         }
@@ -405,51 +446,6 @@ pub(crate) fn check_columns(
         ));
     }
     Ok(())
-}
-
-impl FitRequest {
-    /// The thermal σ's options: T in (0, 1500] K, B > 0, n_d ≥ 0, neither of the latter
-    /// without T, and a probe that gives the lever's resonance and Q (not a quasi-static
-    /// read's stand-ins).
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] naming the option.
-    fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
-        let Some(t) = self.temperature else {
-            return match (self.bandwidth, self.detector_noise) {
-                (None, None) => Ok(()),
-                (b, _) => Err(bad(
-                    if b.is_some() {
-                        "bandwidth"
-                    } else {
-                        "detector_noise"
-                    },
-                    "given without a temperature",
-                    "the bandwidth and the detector noise set the thermal σ: give the temperature",
-                )),
-            };
-        };
-        super::thermal::check_temperature(t)?;
-        let number = crate::error::number;
-        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
-            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));
-        }
-        if let Some(n) = self
-            .detector_noise
-            .filter(|n| !(n.is_finite() && *n >= 0.0))
-        {
-            return Err(bad("detector_noise", number(n), "finite and ≥ 0 (m/√Hz)"));
-        }
-        match model.probe.as_ref().map(|p| &p.assumed) {
-            Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(
-                "temperature",
-                number(t),
-                "the thermal σ needs the lever's modes: give [cantilever] resonance_frequency \
-                 and quality_factor in the probe",
-            )),
-            _ => Ok(()),
-        }
-    }
 }
 
 impl_request! {

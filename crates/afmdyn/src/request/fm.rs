@@ -168,15 +168,13 @@ impl FmRequest {
             range.check_si_distances()?;
         }
         let base = model.params;
-        if self.mode == 0 || self.mode > base.modes {
-            return Err(SimError::out_of_range(
-                "mode",
-                self.mode,
-                "must be in 1..=N, the number of modes of the model (1 for the point mass)",
-            ));
-        }
-        let tol = self.tolerance;
-        super::limits::tolerance("tolerance", tol)?;
+        crate::error::within(
+            "mode",
+            self.mode,
+            1..=base.modes,
+            "must be in 1..=N, the number of modes of the model (1 for the point mass)",
+        )?;
+        super::limits::tolerance("tolerance", self.tolerance)?;
         let a = self.amplitude.map_or(1.0, |a| a / length);
         let offset = base.contact_law.distance_offset();
         let to = range.to.map_or(a + offset, |t| t / length);
@@ -192,7 +190,7 @@ impl FmRequest {
         }
         let mut spec = FmSpec::new(base, values, a);
         spec.mode = self.mode;
-        spec.tolerance = tol;
+        spec.tolerance = self.tolerance;
         Ok(spec)
     }
 }

@@ -199,9 +199,7 @@ impl PeakForceRequest {
             ),
         ))
     }
-}
 
-impl PeakForceRequest {
     /// The cycle's sampling interval, the modulation period over `samples` (s with a probe,
     /// else τ).
     pub(crate) fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
@@ -220,7 +218,6 @@ impl PeakForceRequest {
         model: &Resolved,
         p: &Params,
     ) -> Result<Vec<Params>, SimError> {
-        let request = self;
         let n = sweep.values.len();
         if n == 0 || n > MAX_SWEEP_POINTS {
             return Err(SimError::out_of_range(
@@ -240,7 +237,7 @@ impl PeakForceRequest {
             }
             let q = match sweep.quantity {
                 PeakForceSweepParam::ZC => {
-                    if request.setpoint.is_some() || request.z_c.is_some() {
+                    if self.setpoint.is_some() || self.z_c.is_some() {
                         return Err(SimError::out_of_range(
                             "sweep",
                             "z_c with z_c or setpoint",
@@ -297,12 +294,11 @@ impl_request! {
             None => vec![p],
         };
         let tap = points.iter().map(tap_work).sum::<Result<f64, SimError>>()?;
-        let per_value = if r.setpoint.is_some() {
+        let taps = if r.setpoint.is_some() {
             (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
         } else {
             1.0
         };
-        let taps = per_value;
         let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
         // fits, multipliers and state, and the value's model

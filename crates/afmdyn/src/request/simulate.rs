@@ -167,9 +167,7 @@ impl SimulateRequest {
             rows,
         })
     }
-}
 
-impl SimulateRequest {
     /// The thermal force of the run: `None` without a temperature; with one, its range checked
     /// ([`super::thermal::check_temperature`]) and k_B T in the units of `probe`.
     ///
@@ -236,9 +234,7 @@ impl SimulateRequest {
         it.reset(0.0, z0)?;
         Ok(Box::new(it))
     }
-}
 
-impl SimulateRequest {
     /// [`SimulateRequest::validate`] for a series held whole in memory ([`SeriesStore::Memory`],
     /// `SimulateRequest::record_whole`: τ, V_T, V̇_T, W, Ẇ, contact, force and the state's
     /// entries per sample, 8 bytes each; Python's arrays, the browser's series).

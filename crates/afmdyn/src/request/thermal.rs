@@ -153,14 +153,12 @@ impl_request! {
                 "the highest frequency must be finite and > 0 (Hz)",
             ));
         }
-        if !(1..=MAX_POINTS).contains(&r.points()) {
-            return Err(bad(
-                "points",
-                r.points(),
-                "the number of frequencies must be 1..=10000000",
-            ));
-        }
-        Ok(())
+        crate::error::within(
+            "points",
+            r.points(),
+            1..=MAX_POINTS,
+            "the number of frequencies must be 1..=10000000",
+        )
     };
     // An N × N complex factorisation per frequency; the spectrum's columns, their copies in
     // the layouts and the document's JSON values (256 bytes a frequency).
