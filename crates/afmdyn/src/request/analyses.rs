@@ -41,10 +41,8 @@ request! {
     /// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
     pub struct OrbitRequest {
         /// The period n (1..=64); `None`: the period of the steady state reached, else 1.
-        pub period: Option<usize>,
-        /// The start.
-        #[serde(flatten)]
-        pub start: StartRequest,
+        pub period: Option<usize>;
+        flatten start: StartRequest,
     }
 }
 
@@ -74,10 +72,8 @@ request! {
         pub period: Option<usize>,
         /// At each period doubling, switch to the period-2n branch and continue it too,
         /// recursively up to period 8n (the period-doubling cascade).
-        pub switch: bool = false,
-        /// The start at `from`.
-        #[serde(flatten)]
-        pub start: StartRequest,
+        pub switch: bool = false;
+        flatten start: StartRequest,
     }
 }
 
@@ -149,13 +145,8 @@ request! {
         /// Seed of the initial states.
         pub seed: u64 = super::DEFAULT_SEED,
         /// Relative tolerance for two Poincaré point sets to be the same attractor, > 0.
-        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
-        /// The steady-state search of every start.
-        #[serde(flatten)]
-        pub steady: SteadyRequest,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL;
+        flatten steady: SteadyRequest, integrator: IntegratorRequest,
     }
 }
 
@@ -203,13 +194,8 @@ request! {
         /// Seed of the random starts (keyed by value and start, as a sweep's).
         pub seed: u64 = super::DEFAULT_SEED,
         /// Relative tolerance for two Poincaré point sets at one value to be one attractor, > 0.
-        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
-        /// The steady-state search of every start.
-        #[serde(flatten)]
-        pub steady: SteadyRequest,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL;
+        flatten steady: SteadyRequest, integrator: IntegratorRequest,
     }
 }
 
@@ -258,10 +244,8 @@ request! {
         constants(MAX_OBSERVE_PERIODS)
         pub periods: usize = 1,
         /// Highest harmonic reported.
-        pub harmonics: usize = 10,
-        /// The start.
-        #[serde(flatten)]
-        pub start: StartRequest,
+        pub harmonics: usize = 10;
+        flatten start: StartRequest,
     }
 }
 
@@ -299,10 +283,8 @@ request! {
         /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`];
         /// periods × samples_per_period ≤ [`MAX_CONVERGE_SAMPLES`].
         constants(MAX_SAMPLES_PER_PERIOD, MAX_CONVERGE_SAMPLES)
-        pub samples_per_period: usize = 200,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub samples_per_period: usize = 200;
+        flatten integrator: IntegratorRequest,
     }
 }
 
@@ -338,8 +320,7 @@ impl ConvergeRequest {
 }
 
 pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
-    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)?;
-    Ok(())
+    in_range("samples_per_period", spp, 1..=MAX_SAMPLES_PER_PERIOD)
 }
 
 request! {
@@ -365,13 +346,8 @@ request! {
         pub continuation: bool = true,
         /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
         constants(MAX_THREADS)
-        pub threads: Option<usize>,
-        /// The steady-state search of every point.
-        #[serde(flatten)]
-        pub steady: SteadyRequest,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub threads: Option<usize>;
+        flatten steady: SteadyRequest, integrator: IntegratorRequest,
     }
 }
 
@@ -605,17 +581,12 @@ pub(crate) fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Val
         "steps_per_period": spec.integrator.steps_per_period,
         "tolerance": spec.integrator.tolerance,
     });
-    if let Some(map) = doc.as_object_mut() {
-        match &request.values {
-            Some(v) => {
-                map.insert("values".into(), json!(v));
-            }
-            None => {
-                map.insert("from".into(), json!(request.from));
-                map.insert("to".into(), json!(request.to));
-                map.insert("steps".into(), json!(request.steps));
-            }
-        }
+    let range = match &request.values {
+        Some(v) => json!({ "values": v }),
+        None => json!({ "from": request.from, "to": request.to, "steps": request.steps }),
+    };
+    if let (Some(map), Value::Object(range)) = (doc.as_object_mut(), range) {
+        map.extend(range);
     }
     doc
 }

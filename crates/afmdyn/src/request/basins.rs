@@ -50,13 +50,8 @@ request! {
         pub cluster_tol: f64 = super::DEFAULT_CLUSTER_TOL,
         /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
         constants(MAX_THREADS in super::limits)
-        pub threads: Option<usize>,
-        /// The steady-state search of a start the early tests leave undecided.
-        #[serde(flatten)]
-        pub steady: SteadyRequest,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub threads: Option<usize>;
+        flatten steady: SteadyRequest, integrator: IntegratorRequest,
     }
 }
 

@@ -82,13 +82,8 @@ request! {
         pub max_attractors: usize = 8,
         /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
         constants(MAX_THREADS in super::limits)
-        pub threads: Option<usize>,
-        /// The steady-state search of every run.
-        #[serde(flatten)]
-        pub steady: SteadyRequest,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub threads: Option<usize>;
+        flatten steady: SteadyRequest, integrator: IntegratorRequest,
     }
 }
 

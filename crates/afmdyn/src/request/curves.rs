@@ -121,8 +121,7 @@ impl CurveRequest {
     /// 2..=10000; [`SimError::Budget`] for traces beyond [`super::limits::MAX_TRACE_BYTES`];
     /// [`SimError::Params`] for parameters invalid at an end of the grid.
     pub(crate) fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
-        let tol = self.tolerance;
-        super::limits::tolerance("tolerance", tol)?;
+        super::limits::tolerance("tolerance", self.tolerance)?;
         for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
             let p = spec.base.with(spec.param, v);
             match spec.average {
@@ -130,7 +129,7 @@ impl CurveRequest {
                 None => p.validate()?,
             }
         }
-        spec.integrator.tolerance = tol;
+        spec.integrator.tolerance = self.tolerance;
         // the time average follows the motion in time: no periodic orbits to continue
         spec.branches = self.branches && spec.average.is_none();
         if let Some(n) = self.traces {
@@ -217,26 +216,22 @@ pub fn check_bimodal(base: &Params) -> Result<(), SimError> {
 /// # Errors
 /// [`SimError::OutOfRange`] naming the probe's `[drive].frequency`.
 pub(crate) fn check_single_frequency(base: &Params, what: &'static str) -> Result<(), SimError> {
-    if base.is_multifrequency() {
-        Err(SimError::out_of_range(
-            "[drive].frequency",
-            format!("{} components", 1 + base.components().count()),
-            match what {
-                "fm" => {
-                    "must be one frequency for fm: the further components' frequencies are \
-                         fixed fractions of the first and would follow the PLL (use bimodal for \
-                         a multifrequency AM curve)"
-                }
-                _ => {
-                    "must be one frequency for resonance: the further components' \
-                      frequencies are fixed fractions of the first and would sweep with it \
-                      (use bimodal for a multifrequency AM curve)"
-                }
-            },
-        ))
-    } else {
-        Ok(())
+    if !base.is_multifrequency() {
+        return Ok(());
     }
+    let moves = if what == "fm" {
+        "follow the PLL"
+    } else {
+        "sweep with it"
+    };
+    Err(SimError::out_of_range(
+        "[drive].frequency",
+        format!("{} components", 1 + base.components().count()),
+        format!(
+            "must be one frequency for {what}: the further components' frequencies are fixed \
+             fractions of the first and would {moves} (use bimodal for a multifrequency AM curve)"
+        ),
+    ))
 }
 
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
@@ -346,18 +341,16 @@ pub(crate) fn in_units(e: SimError, unit: f64) -> SimError {
             name: name @ ("from" | "to" | "step"),
             value,
             allowed,
-        } => match value.parse::<f64>() {
-            Ok(v) => SimError::OutOfRange {
-                name,
-                value: crate::error::number(v * unit),
-                allowed,
-            },
-            Err(_) => SimError::OutOfRange {
+        } => {
+            let value = value
+                .parse()
+                .map_or(value, |v: f64| crate::error::number(v * unit));
+            SimError::OutOfRange {
                 name,
                 value,
                 allowed,
-            },
-        },
+            }
+        }
         e => e,
     }
 }

@@ -129,7 +129,11 @@ request! {
 type Columns = (Vec<f64>, Vec<f64>, Option<Vec<f64>>, Option<Vec<f64>>);
 
 /// A refusal naming `name`.
-pub(crate) fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
+pub(crate) fn bad(
+    name: &'static str,
+    value: impl std::fmt::Display,
+    allowed: impl Into<std::borrow::Cow<'static, str>>,
+) -> SimError {
     SimError::out_of_range(name, value, allowed)
 }
 
@@ -168,7 +172,7 @@ impl FitRequest {
             (Some(_), false) => Err(bad(
                 "data",
                 "given with height/force",
-                "give either a data file or the columns height and force, not both".into(),
+                "give either a data file or the columns height and force, not both",
             )),
             #[cfg(feature = "files")]
             (Some(path), true) => read_force_curve(std::path::Path::new(path)),
@@ -176,14 +180,13 @@ impl FitRequest {
             (Some(_), true) => Err(bad(
                 "data",
                 "a file",
-                "this build reads no files: give the columns height and force".into(),
+                "this build reads no files: give the columns height and force",
             )),
             (None, true) => Err(bad(
                 "data",
                 "missing",
                 "a force curve is needed: a CSV file (columns height, force, optional sigma) \
-                 or the columns height and force"
-                    .into(),
+                 or the columns height and force",
             )),
             (None, false) => Ok((
                 self.height.clone(),
@@ -201,8 +204,7 @@ impl FitRequest {
                 "probe",
                 "missing",
                 "fit needs a probe file (the lever's spring constant, the start values and the \
-                 held parameters in SI)"
-                    .into(),
+                 held parameters in SI)",
             )
         })?;
         let name = p.params.contact_law.name();
@@ -213,8 +215,7 @@ impl FitRequest {
                 bad(
                     "law",
                     name,
-                    "the force-curve fit takes the probe's [sample].law = hertz, dmt, jkr or sls"
-                        .into(),
+                    "the force-curve fit takes the probe's [sample].law = hertz, dmt, jkr or sls",
                 )
             })
     }
@@ -254,8 +255,7 @@ impl FitRequest {
                 return Err(bad(
                     "bonded",
                     b,
-                    "bonded is the bottom-effect correction's: give the sample's thickness (m)"
-                        .into(),
+                    "bonded is the bottom-effect correction's: give the sample's thickness (m)",
                 ))
             }
             (None, None) => None,
@@ -296,8 +296,7 @@ impl FitRequest {
             return Err(bad(
                 "segment",
                 "whole",
-                "the jkr law's contact differs on the approach and the retract: fit one of them"
-                    .into(),
+                "the jkr law's contact differs on the approach and the retract: fit one of them",
             ));
         }
         let fit = self.fitted(law);
@@ -321,7 +320,7 @@ impl FitRequest {
                 ));
             }
             if fit[..i].contains(f) {
-                return Err(bad("fit", f, "named twice".into()));
+                return Err(bad("fit", f, "named twice"));
             }
         }
         self.check_range()?;
@@ -333,9 +332,7 @@ impl FitRequest {
         }
         Ok(law)
     }
-}
 
-impl FitRequest {
     /// `range`, when given, is two finite positions lo < hi.
     ///
     /// # Errors
@@ -345,7 +342,50 @@ impl FitRequest {
             Some([lo, hi]) if !(lo.is_finite() && hi.is_finite() && lo < hi) => Err(bad(
                 "range",
                 format!("[{lo}, {hi}]"),
-                "must be two finite positions lo < hi (m)".into(),
+                "must be two finite positions lo < hi (m)",
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The thermal σ's options: T in (0, 1500] K, B > 0, n_d ≥ 0, neither of the latter
+    /// without T, and a probe that gives the lever's resonance and Q (not a quasi-static
+    /// read's stand-ins).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option.
+    fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
+        let Some(t) = self.temperature else {
+            return match (self.bandwidth, self.detector_noise) {
+                (None, None) => Ok(()),
+                (b, _) => Err(bad(
+                    if b.is_some() {
+                        "bandwidth"
+                    } else {
+                        "detector_noise"
+                    },
+                    "given without a temperature",
+                    "the bandwidth and the detector noise set the thermal σ: give the temperature",
+                )),
+            };
+        };
+        super::thermal::check_temperature(t)?;
+        let number = crate::error::number;
+        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
+            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));
+        }
+        if let Some(n) = self
+            .detector_noise
+            .filter(|n| !(n.is_finite() && *n >= 0.0))
+        {
+            return Err(bad("detector_noise", number(n), "finite and ≥ 0 (m/√Hz)"));
+        }
+        match model.probe.as_ref().map(|p| &p.assumed) {
+            Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(
+                "temperature",
+                number(t),
+                "the thermal σ needs the lever's modes: give [cantilever] resonance_frequency \
+                 and quality_factor in the probe",
             )),
             _ => Ok(()),
         }
@@ -385,7 +425,7 @@ pub(crate) fn check_columns(
             return Err(bad(
                 name,
                 format!("row {}: {}", i + 1, column[i]),
-                "every value must be finite".into(),
+                "every value must be finite",
             ));
         }
     }
@@ -393,7 +433,7 @@ pub(crate) fn check_columns(
         return Err(bad(
             "sigma",
             format!("row {}", i + 1),
-            "must be finite and > 0 (N)".into(),
+            "must be finite and > 0 (N)",
         ));
     }
     if let Some(i) = time
@@ -402,61 +442,10 @@ pub(crate) fn check_columns(
         return Err(bad(
             "time",
             format!("row {}", i + 1),
-            "must be finite and strictly increasing (s)".into(),
+            "must be finite and strictly increasing (s)",
         ));
     }
     Ok(())
-}
-
-impl FitRequest {
-    /// The thermal σ's options: T in (0, 1500] K, B > 0, n_d ≥ 0, neither of the latter
-    /// without T, and a probe that gives the lever's resonance and Q (not a quasi-static
-    /// read's stand-ins).
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] naming the option.
-    fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
-        let Some(t) = self.temperature else {
-            return match (self.bandwidth, self.detector_noise) {
-                (None, None) => Ok(()),
-                (b, _) => Err(bad(
-                    if b.is_some() {
-                        "bandwidth"
-                    } else {
-                        "detector_noise"
-                    },
-                    "given without a temperature",
-                    "the bandwidth and the detector noise set the thermal σ: give the temperature"
-                        .into(),
-                )),
-            };
-        };
-        super::thermal::check_temperature(t)?;
-        let number = crate::error::number;
-        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
-            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)".into()));
-        }
-        if let Some(n) = self
-            .detector_noise
-            .filter(|n| !(n.is_finite() && *n >= 0.0))
-        {
-            return Err(bad(
-                "detector_noise",
-                number(n),
-                "finite and ≥ 0 (m/√Hz)".into(),
-            ));
-        }
-        match model.probe.as_ref().map(|p| &p.assumed) {
-            Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(
-                "temperature",
-                number(t),
-                "the thermal σ needs the lever's modes: give [cantilever] resonance_frequency \
-                 and quality_factor in the probe"
-                    .into(),
-            )),
-            _ => Ok(()),
-        }
-    }
 }
 
 impl_request! {
@@ -485,8 +474,7 @@ impl_request! {
                     name,
                     value,
                     "the bottom-effect correction is the force-curve fit's; a dynamic curve's \
-                     sample is a half space"
-                        .into(),
+                     sample is a half space",
                 ));
             }
             return r.check_range();

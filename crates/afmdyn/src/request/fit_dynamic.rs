@@ -74,8 +74,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             "data",
             "no amplitude, phase or frequency_shift column",
             "an AM curve has the column z (m) and amplitude (m) and/or phase (deg); an FM \
-             curve z (m) and frequency_shift (Hz)"
-                .into(),
+             curve z (m) and frequency_shift (Hz)",
         ));
     }
     if !(MIN_FIT_ROWS..=crate::analysis::stepped::MAX_CURVE_POINTS).contains(&m) {
@@ -97,7 +96,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             return Err(bad(
                 name,
                 format!("row {}: {}", i + 1, c[i]),
-                "every value must be finite".into(),
+                "every value must be finite",
             ));
         }
         let sigma = name.starts_with("sigma_");
@@ -105,7 +104,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             return Err(bad(
                 name,
                 format!("row {}: {}", i + 1, c[i]),
-                "a standard deviation must be > 0".into(),
+                "a standard deviation must be > 0",
             ));
         }
     }
@@ -114,8 +113,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             "data",
             "frequency_shift with amplitude_2 or phase_2",
             "a curve is an FM curve (frequency_shift) or an AM one (amplitude, phase and the \
-             bimodal amplitude_2, phase_2), not both"
-                .into(),
+             bimodal amplitude_2, phase_2), not both",
         ));
     }
     let channels = [
@@ -131,8 +129,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             "missing",
             "fitting several bimodal channels together needs the σ column of each \
              (sigma_amplitude, sigma_phase, sigma_amplitude_2, sigma_phase_2: their units \
-             differ)"
-                .into(),
+             differ)",
         ));
     }
     if d.frequency_shift.is_none()
@@ -144,8 +141,7 @@ pub(crate) fn check_data(d: &AmData) -> Result<(), SimError> {
             "sigma",
             "missing",
             "fitting amplitude (m) and phase (deg) together needs their σ columns \
-             sigma_amplitude and sigma_phase (the two channels' units differ)"
-                .into(),
+             sigma_amplitude and sigma_phase (the two channels' units differ)",
         ));
     }
     Ok(())

@@ -74,8 +74,7 @@ impl FitMapRequest {
                 "data",
                 "missing",
                 "a map is needed: a long-format CSV (x, y, height, force) or the NetCDF file \
-                 afmdyn.export_map writes"
-                    .into(),
+                 afmdyn.export_map writes",
             )
         })
     }
@@ -103,12 +102,12 @@ impl FitMapRequest {
             (Some(_), Some(z)) => Err(bad(
                 "substrate_height",
                 crate::error::number(z),
-                "give the sample's thickness or the substrate's height, not both".into(),
+                "give the sample's thickness or the substrate's height, not both",
             )),
             (_, Some(z)) if !z.is_finite() => Err(bad(
                 "substrate_height",
                 crate::error::number(z),
-                "the substrate's piezo height must be finite (m)".into(),
+                "the substrate's piezo height must be finite (m)",
             )),
             _ => Ok(()),
         }

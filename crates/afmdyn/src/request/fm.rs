@@ -13,7 +13,6 @@ use crate::analysis::fm::FmSpec;
 use crate::analysis::fm::DEFAULT_LOOP_TOLERANCE;
 use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
 use crate::error::SimError;
-use crate::report::CurveUnits;
 
 request! {
     /// `fm`: an FM curve from `from` to `to` (z_c; m with a probe, else g₀) at the oscillation
@@ -116,11 +115,6 @@ pub fn default_from(base: &crate::Params, a: f64, to: f64) -> Option<f64> {
 }
 
 impl FmRequest {
-    /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
-    pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        CurveUnits::of(model.probe.as_ref(), true)
-    }
-
     /// The analysis' spec on `model`: the z_c grid (α5 values, from the far end), the amplitude
     /// in g₀, the mode and the tolerance.
     ///
@@ -129,7 +123,7 @@ impl FmRequest {
     /// or `points` (as an approach curve's); [`SimError::Params`] for a model invalid at an
     /// end of the grid.
     pub fn spec(&self, model: &Resolved) -> Result<FmSpec, SimError> {
-        let length = Self::units(model).length;
+        let length = model.units(true).length;
         let range = CurveRequest {
             from: self.from,
             to: self.to,
@@ -174,15 +168,13 @@ impl FmRequest {
             range.check_si_distances()?;
         }
         let base = model.params;
-        if self.mode == 0 || self.mode > base.modes {
-            return Err(SimError::out_of_range(
-                "mode",
-                self.mode,
-                "must be in 1..=N, the number of modes of the model (1 for the point mass)",
-            ));
-        }
-        let tol = self.tolerance;
-        super::limits::tolerance("tolerance", tol)?;
+        crate::error::within(
+            "mode",
+            self.mode,
+            1..=base.modes,
+            "must be in 1..=N, the number of modes of the model (1 for the point mass)",
+        )?;
+        super::limits::tolerance("tolerance", self.tolerance)?;
         let a = self.amplitude.map_or(1.0, |a| a / length);
         let offset = base.contact_law.distance_offset();
         let to = range.to.map_or(a + offset, |t| t / length);
@@ -198,7 +190,7 @@ impl FmRequest {
         }
         let mut spec = FmSpec::new(base, values, a);
         spec.mode = self.mode;
-        spec.tolerance = tol;
+        spec.tolerance = self.tolerance;
         Ok(spec)
     }
 }

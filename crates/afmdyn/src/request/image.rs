@@ -143,9 +143,7 @@ impl ImageRequest {
         self.lines
             .unwrap_or(if map.size.1 == 0.0 { 1 } else { self.pixels })
     }
-}
 
-impl ImageRequest {
     /// Check the request against the map.
     ///
     /// # Errors

@@ -46,6 +46,21 @@ impl ImageJob {
     pub fn model(&self) -> Result<Resolved, SimError> {
         Ok(Resolved::plain(background_probe(&self.probe)?.params))
     }
+
+    /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
+    /// setpoint force > 0, no PI feedback and no setpoint study.
+    fn validate_peakforce(&self) -> Result<(), SimError> {
+        if self.feedback.is_some() || self.study.is_some() {
+            return Err(SimError::out_of_range(
+                "mode",
+                "peakforce",
+                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
+                 setpoint study)",
+            ));
+        }
+        self.request.validate_grid(&self.sample)?;
+        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
+    }
 }
 
 /// An image as a front end that knows it by name gives it (Python's `afmdyn.image`, and
@@ -142,23 +157,6 @@ impl ImageKeywords {
             request: self.request(),
             scan: self.feedback.unwrap_or_default(),
         })
-    }
-}
-
-impl ImageJob {
-    /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
-    /// setpoint force > 0, no PI feedback and no setpoint study.
-    fn validate_peakforce(&self) -> Result<(), SimError> {
-        if self.feedback.is_some() || self.study.is_some() {
-            return Err(SimError::out_of_range(
-                "mode",
-                "peakforce",
-                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
-                 setpoint study)",
-            ));
-        }
-        self.request.validate_grid(&self.sample)?;
-        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
     }
 }
 

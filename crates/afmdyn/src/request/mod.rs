@@ -81,7 +81,10 @@ macro_rules! impl_request {
 /// A field is `$(#[attr])* $(constants(NAME, …))? pub name: Type $(= default)?`: without
 /// `= default` it takes its type's `Default::default()`; `constants(NAME, …)` lists the
 /// constants its doc cites (limits, defaults) under the schema's `x-constants`
-/// (`{"NAME": NAME, …}`; `NAME in path` for one not in scope, `{"NAME": path::NAME}`). Attributes before `pub struct` follow
+/// (`{"NAME": NAME, …}`; `NAME in path` for one not in scope, `{"NAME": path::NAME}`). After
+/// a `;`, `flatten name: Type, …` are the last fields: requests whose fields are the request's
+/// own (`#[serde(flatten)]`, default `Type::default()`: the steady-state search, the
+/// integrator, a start, a curve). Attributes before `pub struct` follow
 /// the shared ones (the doc, `#[derive(Copy)]`, schemars attributes of the whole struct); a
 /// doc of `default` itself follows the struct, as `/// … impl Default;`.
 macro_rules! request {
@@ -93,6 +96,7 @@ macro_rules! request {
                 $(constants($($c:ident $(in $($m:ident)::+)?),+))?
                 pub $field:ident: $ty:ty $(= $default:expr)?
             ),* $(,)?
+            $(; flatten $($flat:ident: $fty:ty),+ $(,)?)?
         }
         $($(#[$dattr:meta])+ impl Default;)?
     ) => {
@@ -109,12 +113,17 @@ macro_rules! request {
                 )])?
                 pub $field: $ty,
             )*
+            $($(
+                #[doc = concat!("The flattened [`", stringify!($fty), "`].")]
+                #[serde(flatten)]
+                pub $flat: $fty,
+            )+)?
         }
 
         impl Default for $name {
             $($(#[$dattr])+)?
             fn default() -> Self {
-                Self { $($field: request!(@default $($default)?),)* }
+                Self { $($field: request!(@default $($default)?),)* $($($flat: Default::default(),)+)? }
             }
         }
     };

@@ -50,137 +50,54 @@ pub struct ParamInfo {
     pub kind: ValueKind,
 }
 
+/// A table of [`ParamInfo`], an entry a line: `name | alias, symbol, unit, range, default,
+/// kind: help` (`| alias` only where the paper names it otherwise).
+macro_rules! param_infos {
+    ($($name:literal $(| $alias:literal)?, $symbol:literal, $unit:literal, $range:expr,
+       $default:literal, $kind:ident: $help:expr;)*) => {
+        [$(ParamInfo {
+            name: $name,
+            alias: param_infos!(@alias $($alias)?),
+            symbol: $symbol,
+            unit: $unit,
+            range: $range,
+            default: $default,
+            help: $help,
+            kind: ValueKind::$kind,
+        }),*]
+    };
+    (@alias) => { None };
+    (@alias $alias:literal) => { Some($alias) };
+}
+
 /// The model parameters before the law's groups, in the order the front ends list them.
-const BEFORE_GROUPS: [ParamInfo; 10] = [
-    ParamInfo {
-        name: "modes",
-        alias: None,
-        symbol: "N",
-        unit: "1",
-        range: "1..=20",
-        default: "3",
-        help: "number of Galerkin modes N (eq. 9)",
-        kind: ValueKind::Integer,
-    },
-    ParamInfo {
-        name: "tip_mass_ratio",
-        alias: Some("alpha1"),
-        symbol: "α1",
-        unit: "1",
-        range: "0..=1e4",
-        default: "0.1",
-        help: "tip-mass ratio α1 = M/(mL)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "drive_amplitude",
-        alias: Some("alpha2"),
-        symbol: "α2",
-        unit: "1",
-        range: "0..=1e6",
-        default: "0.1",
-        help: "base-drive amplitude α2 = f/g0",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "beam_damping",
-        alias: Some("alpha3"),
-        symbol: "α3",
-        unit: "1",
-        range: "0..=1e4",
-        default: "0.1",
-        help: "beam damping α3",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "contact_stiffness",
-        alias: Some("alpha4"),
-        symbol: "α4",
-        unit: "1",
-        range: "0..=1e8",
-        default: "20",
-        help: "contact stiffness α4 = K1 L³/(EI)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "gap",
-        alias: Some("alpha5"),
-        symbol: "α5",
-        unit: "1",
-        range: "-1e6..=1e6",
-        default: "0",
-        help: "tip–sample gap α5 = g1/g0 (may be negative)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "contact_damping",
-        alias: Some("alpha6"),
-        symbol: "α6",
-        unit: "1",
-        range: "0..=1e4",
-        default: "0.2",
-        help: "contact damping α6",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "omega",
-        alias: None,
-        symbol: "Ω",
-        unit: "1",
-        range: "1e-3..=1e5",
-        default: "2.6",
-        help: "dimensionless drive frequency Ω",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "contact_law",
-        alias: None,
-        symbol: "F_c",
-        unit: "1",
-        range: crate::contact::LawKind::EXPECTED,
-        default: "linear",
-        // the registry's laws and doc lines ([`law_help`])
-        help: "tip–sample law",
-        kind: ValueKind::Law,
-    },
-    ParamInfo {
-        name: "excitation",
-        alias: None,
-        symbol: "—",
-        unit: "1",
-        range: "base or tip",
-        default: "base",
-        help: "where the drive acts on the beam: base (α2 sin Ωτ, the paper; acoustic) or tip (a \
-         force α2 cos Ωτ at the tip: magnetic, photothermal)",
-        kind: ValueKind::Excitation,
-    },
-];
+const BEFORE_GROUPS: [ParamInfo; 10] = param_infos! {
+    "modes", "N", "1", "1..=20", "3", Integer: "number of Galerkin modes N (eq. 9)";
+    "tip_mass_ratio" | "alpha1", "α1", "1", "0..=1e4", "0.1", Real: "tip-mass ratio α1 = M/(mL)";
+    "drive_amplitude" | "alpha2", "α2", "1", "0..=1e6", "0.1", Real:
+        "base-drive amplitude α2 = f/g0";
+    "beam_damping" | "alpha3", "α3", "1", "0..=1e4", "0.1", Real: "beam damping α3";
+    "contact_stiffness" | "alpha4", "α4", "1", "0..=1e8", "20", Real:
+        "contact stiffness α4 = K1 L³/(EI)";
+    "gap" | "alpha5", "α5", "1", "-1e6..=1e6", "0", Real:
+        "tip–sample gap α5 = g1/g0 (may be negative)";
+    "contact_damping" | "alpha6", "α6", "1", "0..=1e4", "0.2", Real: "contact damping α6";
+    "omega", "Ω", "1", "1e-3..=1e5", "2.6", Real: "dimensionless drive frequency Ω";
+    // the help: the registry's laws and doc lines ([`law_help`])
+    "contact_law", "F_c", "1", crate::contact::LawKind::EXPECTED, "linear", Law: "tip–sample law";
+    "excitation", "—", "1", "base or tip", "base", Excitation:
+        "where the drive acts on the beam: base (α2 sin Ωτ, the paper; acoustic) or tip (a \
+         force α2 cos Ωτ at the tip: magnetic, photothermal)";
+};
 
 /// The SI model parameters after the law's groups (they need a probe file).
-const AFTER_GROUPS: [ParamInfo; 2] = [
-    ParamInfo {
-        name: "z_c",
-        alias: None,
-        symbol: "z_c",
-        unit: "m",
-        range: "finite",
-        default: "the probe's",
-        help: "with a probe: the rest tip–sample distance z_c in metres (sets α5)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "drive_frequency",
-        alias: None,
-        symbol: "f",
-        unit: "Hz",
-        range: "> 0",
-        default: "the probe's",
-        help:
-            "with a probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is \
-         kept)",
-        kind: ValueKind::Real,
-    },
-];
+const AFTER_GROUPS: [ParamInfo; 2] = param_infos! {
+    "z_c", "z_c", "m", "finite", "the probe's", Real:
+        "with a probe: the rest tip–sample distance z_c in metres (sets α5)";
+    "drive_frequency", "f", "Hz", "> 0", "the probe's", Real:
+        "with a probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is \
+         kept)";
+};
 
 /// Every model parameter a request takes, in the order the front ends list them: the model's
 /// own, the law groups of the registry ([`crate::contact::GROUPS`], each described by its
@@ -550,6 +467,34 @@ impl ModelSpec {
         }
         Ok(())
     }
+
+    /// Refuse the values a probe sets in SI ([`probe_sets`]): the first one given, named.
+    fn refuse_dimensionless_under_probe(&self) -> Result<(), SimError> {
+        let reals = self
+            .reals()
+            .filter_map(|(name, v)| Some((name, crate::error::number(v?))));
+        let law = self
+            .contact_law
+            .map(|l| ("contact_law", l.name().to_string()));
+        let excitation = self
+            .excitation
+            .map(|e| ("excitation", e.name().to_string()));
+        for (name, value) in reals.chain(law).chain(excitation) {
+            if let Some(allowed) = probe_sets(name) {
+                return Err(SimError::out_of_range(name, value, allowed));
+            }
+        }
+        Ok(())
+    }
+
+    /// Read a config file's text (TOML, the keys of [`MODEL_PARAMETERS`]); the error is one
+    /// line: `line L, column C: message`.
+    ///
+    /// # Errors
+    /// [`ModelSpecError`] for a syntax error, an unknown key or a value of the wrong type.
+    pub fn from_toml(text: &str) -> Result<ModelSpec, ModelSpecError> {
+        parse_toml(text).map_err(ModelSpecError)
+    }
 }
 
 /// α5 of `p` for the rest distance `z` (m, the request's `z_c`): z in units of the probe's
@@ -685,51 +630,10 @@ pub(crate) fn probe_sets(name: &str) -> Option<std::borrow::Cow<'static, str>> {
     )
 }
 
-impl ModelSpec {
-    /// Refuse the values a probe sets in SI ([`probe_sets`]): the first one given, named.
-    fn refuse_dimensionless_under_probe(&self) -> Result<(), SimError> {
-        for (name, value) in self.reals() {
-            if let (Some(v), Some(allowed)) = (value, probe_sets(name)) {
-                return Err(SimError::out_of_range(
-                    name,
-                    crate::error::number(v),
-                    allowed,
-                ));
-            }
-        }
-        if let Some(law) = self.contact_law {
-            return Err(SimError::out_of_range(
-                "contact_law",
-                law.name(),
-                PROBE_SETS[7].1,
-            ));
-        }
-        if let Some(e) = self.excitation {
-            return Err(SimError::out_of_range(
-                "excitation",
-                e.name(),
-                PROBE_SETS[8].1,
-            ));
-        }
-        Ok(())
-    }
-}
-
 /// A model spec that could not be read (a config file's text): the parser's message.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{0}")]
 pub struct ModelSpecError(pub String);
-
-impl ModelSpec {
-    /// Read a config file's text (TOML, the keys of [`MODEL_PARAMETERS`]); the error is one
-    /// line: `line L, column C: message`.
-    ///
-    /// # Errors
-    /// [`ModelSpecError`] for a syntax error, an unknown key or a value of the wrong type.
-    pub fn from_toml(text: &str) -> Result<ModelSpec, ModelSpecError> {
-        parse_toml(text).map_err(ModelSpecError)
-    }
-}
 
 /// Parse TOML text into `T`; the error is one line: "line L, column C: message" (for a
 /// duplicate key, the key).

@@ -63,8 +63,13 @@ macro_rules! analyses {
             };
         }
 
-        /// The request of analysis `name` from `d` ([`parse`]).
-        fn parse_named<'de, D: Deserializer<'de>>(
+        /// The request of analysis `name` ([`NAMES`], and `reconstruct_document`) from `d`;
+        /// `None` for another name.
+        ///
+        /// # Errors
+        /// The deserialiser's: an unknown keyword (`deny_unknown_fields`), a value of the wrong
+        /// type.
+        pub fn parse<'de, D: Deserializer<'de>>(
             name: &str,
             d: D,
         ) -> Result<Option<NamedRequest>, D::Error> {
@@ -143,49 +148,20 @@ impl NamedRequest {
     }
 }
 
-/// The request of analysis `name` ([`NAMES`], and `reconstruct_document`) from `d`; `None`
-/// for another name.
-///
-/// # Errors
-/// The deserialiser's: an unknown keyword (`deny_unknown_fields`), a value of the wrong type.
-pub fn parse<'de, D: Deserializer<'de>>(
-    name: &str,
-    d: D,
-) -> Result<Option<NamedRequest>, D::Error> {
-    parse_named(name, d)
-}
-
 /// The default request of analysis `name` as JSON (what a front end's keywords default to);
 /// `None` for a name without one. Besides [`NAMES`] (but `modes` and `bimodal`, which is
 /// `approach`'s), `bifurcation` and `chart`.
 pub fn default_request(name: &str) -> Option<Value> {
-    use super::{BifurcationRequest, ChartRequest};
-    fn v<T: serde::Serialize + Default>() -> Option<Value> {
-        serde_json::to_value(T::default()).ok()
-    }
-    match name {
-        "simulate" => v::<SimulateRequest>(),
-        "converge" => v::<ConvergeRequest>(),
-        "bifurcation" => v::<BifurcationRequest>(),
-        "attractors" => v::<AttractorsRequest>(),
-        "global_continuation" => v::<GlobalContinuationRequest>(),
-        "orbit" => v::<OrbitRequest>(),
-        "continuation" => v::<ContinuationRequest>(),
-        "lyapunov" => v::<LyapunovRequest>(),
-        "observe" => v::<ObserveRequest>(),
-        "approach" => v::<ApproachRequest>(),
-        "resonance" => v::<ResonanceRequest>(),
-        "basins" => v::<BasinsRequest>(),
-        "chart" => v::<ChartRequest>(),
-        "reconstruct" => v::<ReconstructRequest>(),
-        "fm" => v::<FmRequest>(),
-        "peakforce" => v::<super::PeakForceRequest>(),
-        "fit" => v::<super::FitRequest>(),
-        "fit_map" => v::<super::FitMapRequest>(),
-        "thermal" => v::<super::ThermalRequest>(),
-        "calibrate" => v::<super::CalibrateRequest>(),
-        _ => None,
-    }
+    let named = match name {
+        "modes" | "bimodal" => return None,
+        "bifurcation" => return serde_json::to_value(super::BifurcationRequest::default()).ok(),
+        "chart" => return serde_json::to_value(super::ChartRequest::default()).ok(),
+        // every field of a request has its default (`#[serde(default)]`)
+        _ => parse(name, Value::Object(serde_json::Map::new())).ok()??,
+    };
+    each_request!(&named.0, r => serde_json::to_value(r).ok(),
+        Simulate(s) => serde_json::to_value(s).ok(),
+        ReconstructDocument(_f) => None)
 }
 
 #[cfg(test)]

@@ -12,7 +12,6 @@ use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, FIT_BAND, SETP
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
-use crate::report::CurveUnits;
 
 pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_POINTS};
 
@@ -66,11 +65,6 @@ request! {
 }
 
 impl PeakForceRequest {
-    /// The units of the document: SI with a probe, else the model's.
-    pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        CurveUnits::of(model.probe.as_ref(), true)
-    }
-
     /// The analysis' options.
     pub fn options(&self) -> PeakForceOptions {
         PeakForceOptions {
@@ -129,7 +123,7 @@ impl PeakForceRequest {
                 ));
             }
         }
-        let length = Self::units(model).length;
+        let length = model.units(true).length;
         let mut q = p;
         match (self.z_c, self.setpoint) {
             (Some(_), Some(_)) => {
@@ -205,13 +199,11 @@ impl PeakForceRequest {
             ),
         ))
     }
-}
 
-impl PeakForceRequest {
     /// The cycle's sampling interval, the modulation period over `samples` (s with a probe,
     /// else τ).
     pub(crate) fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
-        std::f64::consts::TAU / p.omega / self.samples as f64 * Self::units(model).time
+        std::f64::consts::TAU / p.omega / self.samples as f64 * model.units(true).time
     }
 
     /// The model of every value of `sweep` (`p` the request's model with its checks done).
@@ -226,7 +218,6 @@ impl PeakForceRequest {
         model: &Resolved,
         p: &Params,
     ) -> Result<Vec<Params>, SimError> {
-        let request = self;
         let n = sweep.values.len();
         if n == 0 || n > MAX_SWEEP_POINTS {
             return Err(SimError::out_of_range(
@@ -235,7 +226,7 @@ impl PeakForceRequest {
                 format!("must have 1..={MAX_SWEEP_POINTS} values"),
             ));
         }
-        let units = Self::units(model);
+        let units = model.units(true);
         let bad = |v: f64, why: &str| {
             SimError::out_of_range("sweep", v, format!("{}: {why}", sweep.quantity.name()))
         };
@@ -246,7 +237,7 @@ impl PeakForceRequest {
             }
             let q = match sweep.quantity {
                 PeakForceSweepParam::ZC => {
-                    if request.setpoint.is_some() || request.z_c.is_some() {
+                    if self.setpoint.is_some() || self.z_c.is_some() {
                         return Err(SimError::out_of_range(
                             "sweep",
                             "z_c with z_c or setpoint",
@@ -303,12 +294,11 @@ impl_request! {
             None => vec![p],
         };
         let tap = points.iter().map(tap_work).sum::<Result<f64, SimError>>()?;
-        let per_value = if r.setpoint.is_some() {
+        let taps = if r.setpoint.is_some() {
             (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
         } else {
             1.0
         };
-        let taps = per_value;
         let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
         // fits, multipliers and state, and the value's model

@@ -255,9 +255,7 @@ impl ReconstructRequest {
         }
         Some(law)
     }
-}
 
-impl ReconstructRequest {
     /// The request of an `afmdyn fm` document in SI (the `fm` curve's document): the distances
     /// of closest approach `curve.min_distance` (the lower turning points, static deflection
     /// included), `curve.frequency_shift`, and the document's `spring_constant`,

@@ -30,7 +30,7 @@ use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::{self, CurveUnits};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 /// The model of a run: the resolved parameters and the probe file they came from, if any
@@ -50,6 +50,12 @@ impl Resolved {
             params,
             probe: None,
         }
+    }
+
+    /// The units of a curve's or a tap's document: SI (m, N, J, and with `hz` frequencies in
+    /// Hz: a resonance's, FM's and PeakForce's) with a probe, else the model's.
+    pub(crate) fn units(&self, hz: bool) -> CurveUnits {
+        CurveUnits::of(self.probe.as_ref(), hz)
     }
 }
 
@@ -302,13 +308,6 @@ request! {
 }
 
 impl ApproachRequest {
-    /// The units of the curve: SI (m, N, J) with a probe, else the model's.
-    pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        CurveUnits::of(model.probe.as_ref(), false)
-    }
-}
-
-impl ApproachRequest {
     /// The stepped sweep of `model` ([`approach_request`]).
     ///
     /// # Errors
@@ -327,7 +326,7 @@ impl ApproachRequest {
         let mut spec = approach_request(
             model.params,
             &self.curve,
-            Self::units(model).length,
+            model.units(false).length,
             average,
         )?;
         if !average && !self.exact && uses_torus(&model.params) {
@@ -343,17 +342,8 @@ request! {
     #[cfg_attr(feature = "schema", schemars(extend("x-swept" = "frequency")))]
     pub struct ResonanceRequest {
         /// The mode k (1-based) whose resonance is swept.
-        pub mode: usize = 1,
-        /// The curve's range and options.
-        #[serde(flatten)]
-        pub curve: CurveRequest,
-    }
-}
-
-impl ResonanceRequest {
-    /// The units of the curve: SI (m, N, J, Hz) with a probe, else the model's.
-    pub(crate) fn units(model: &Resolved) -> CurveUnits {
-        CurveUnits::of(model.probe.as_ref(), true)
+        pub mode: usize = 1;
+        flatten curve: CurveRequest,
     }
 }
 
@@ -363,7 +353,7 @@ impl ResonanceRequest {
     /// # Errors
     /// As [`resonance_request`].
     pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
-        let hz = Self::units(model).hz_per_omega.unwrap_or(1.0);
+        let hz = model.units(true).hz_per_omega.unwrap_or(1.0);
         resonance_request(self.computed_at(model)?, self.mode, &self.curve, hz)
     }
 }
@@ -371,7 +361,7 @@ impl ResonanceRequest {
 /// `bimodal`: the approach curve of a drive with two or more components
 /// (`super::curves::check_bimodal`), its files named `bimodal`; its refusals name
 /// the approach curve it is.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct Bimodal(pub ApproachRequest);
 

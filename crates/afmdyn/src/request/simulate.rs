@@ -56,10 +56,8 @@ request! {
         /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
         /// a function of its seed, whatever the threads.
         #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
-        pub seed: u64 = 0,
-        /// The integrator.
-        #[serde(flatten)]
-        pub integrator: IntegratorRequest,
+        pub seed: u64 = 0;
+        flatten integrator: IntegratorRequest,
     }
 }
 
@@ -171,9 +169,7 @@ impl SimulateRequest {
             rows,
         })
     }
-}
 
-impl SimulateRequest {
     /// The thermal force of the run: `None` without a temperature; with one, its range checked
     /// ([`super::thermal::check_temperature`]) and k_B T in the units of `probe`.
     ///
@@ -240,9 +236,7 @@ impl SimulateRequest {
         it.reset(0.0, z0)?;
         Ok(Box::new(it))
     }
-}
 
-impl SimulateRequest {
     /// [`SimulateRequest::validate`] for a series held whole in memory ([`SeriesStore::Memory`],
     /// `SimulateRequest::record_whole`: τ, V_T, V̇_T, W, Ẇ, contact, force and the state's
     /// entries per sample, 8 bytes each; Python's arrays, the browser's series).

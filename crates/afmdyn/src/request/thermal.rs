@@ -3,6 +3,7 @@
 //! ranges and its declared cost ([`crate::analysis::thermal`] computes it).
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
+use super::fit::bad;
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::error::SimError;
@@ -141,10 +142,6 @@ pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), S
     Ok(())
 }
 
-fn bad(name: &'static str, value: impl ToString, allowed: &'static str) -> SimError {
-    SimError::out_of_range(name, value.to_string(), allowed)
-}
-
 impl_request! {
     ThermalRequest, "thermal", advice = "ask for fewer points";
     validate |r, model| {
@@ -156,14 +153,12 @@ impl_request! {
                 "the highest frequency must be finite and > 0 (Hz)",
             ));
         }
-        if !(1..=MAX_POINTS).contains(&r.points()) {
-            return Err(bad(
-                "points",
-                r.points(),
-                "the number of frequencies must be 1..=10000000",
-            ));
-        }
-        Ok(())
+        crate::error::within(
+            "points",
+            r.points(),
+            1..=MAX_POINTS,
+            "the number of frequencies must be 1..=10000000",
+        )
     };
     // An N × N complex factorisation per frequency; the spectrum's columns, their copies in
     // the layouts and the document's JSON values (256 bytes a frequency).

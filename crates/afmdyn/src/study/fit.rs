@@ -55,7 +55,7 @@ impl FitRequest {
             bad(
                 "bandwidth",
                 "missing",
-                "the thermal σ needs the detection bandwidth (Hz), or a time column".into(),
+                "the thermal σ needs the detection bandwidth (Hz), or a time column",
             )
         })?;
         let units = super::model_units(&probe.scales);
@@ -97,8 +97,7 @@ impl FitRequest {
                 "time",
                 "missing",
                 "the sls law's force depends on the indentation's history: give the rows' \
-                 times (s), a time column"
-                    .into(),
+                 times (s), a time column",
             ));
         }
         curve.time = time;

@@ -43,7 +43,7 @@ pub(crate) fn execute(
         bad(
             "probe",
             "missing",
-            "fit needs a probe file (start values and held parameters in SI)".into(),
+            "fit needs a probe file (start values and held parameters in SI)",
         )
     })?;
     let law_name = probe.params.contact_law.name();
@@ -53,7 +53,7 @@ pub(crate) fn execute(
             bad(
                 "law",
                 law_name,
-                "the dynamic fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
+                "the dynamic fit takes the probe's [sample].law = hertz, dmt or jkr",
             )
         })?;
     let am_probe = am_probe(probe)?;
@@ -72,8 +72,7 @@ pub(crate) fn execute(
             "probe",
             "a single-frequency drive",
             "the bimodal channels amplitude_2 and phase_2 need a probe whose drive has a second \
-             component ([drive] frequency = [f1, f2], free_amplitude = [A1, A2])"
-                .into(),
+             component ([drive] frequency = [f1, f2], free_amplitude = [A1, A2])",
         ));
     }
     let z_index = am.iter().position(|&p| p == AmParam::ZOffset);
@@ -159,15 +158,14 @@ fn parameters(
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
                  sample.viscosity (dmt, jkr), sample.damping (hertz), sample.adhesion_energy (jkr), \
                  tip.radius, \
-                 cantilever.quality_factor, drive.free_amplitude and z_offset"
-                    .into(),
+                 cantilever.quality_factor, drive.free_amplitude and z_offset",
             )
         })?;
-        law_refusal(p, law_name).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
+        law_refusal(p, law_name).map_or(Ok(()), |why| Err(bad("fit", n, why)))?;
         if am.contains(&p) {
-            return Err(bad("fit", n, "named twice".into()));
+            return Err(bad("fit", n, "named twice"));
         }
-        lever_refusal(p, probe, data).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
+        lever_refusal(p, probe, data).map_or(Ok(()), |why| Err(bad("fit", n, why)))?;
         let (start, scale) = start_and_scale(p, am_probe);
         // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
         // a value near its lower end (a modulus of GPa in a range to TPa), where the

@@ -54,7 +54,7 @@ struct Frame {
 
 impl Frame {
     fn new(model: &Resolved, curve: &FmCurve) -> Frame {
-        let u = FmRequest::units(model);
+        let u = model.units(true);
         Frame {
             u,
             hz: u.hz_per_omega.unwrap_or(1.0),

@@ -142,7 +142,7 @@ impl Analysis for PeakForceRequest {
         }
         match self.setpoint {
             Some(f) => {
-                let force = Self::units(model).force;
+                let force = model.units(true).force;
                 let opts = SetpointOptions {
                     tap: self.options(),
                     ..SetpointOptions::default()
@@ -211,7 +211,7 @@ fn execute_sweep(
     p: &Params,
     progress: &Progress,
 ) -> Result<PeakForceResult, SimError> {
-    let force = PeakForceRequest::units(model).force;
+    let force = model.units(true).force;
     let study = PeakForceStudy {
         points: request.sweep_points(sweep, model, p)?,
         setpoint: request.setpoint.map(|f| f / force),
@@ -353,7 +353,7 @@ pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
 /// (time, deflection, distance, force from the largest separation) and `curve` (the
 /// force–distance curve, approach and retract), `z_c`, `units`, `method`, `warnings`.
 pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
-    let u = PeakForceRequest::units(model);
+    let u = model.units(true);
     let tap = &r.tap;
     let c = &tap.channels;
     // a sweep's single-tap blocks are its first computed value's (its Ω in a sweep of f_m)
@@ -508,7 +508,7 @@ fn sweep_block(
 /// probe, for a law with a tip radius `has_radius`) or as the Hertz group.
 fn sweep_frame(model: &Resolved, has_radius: bool) -> super::peakforce_sweep::Frame {
     super::peakforce_sweep::Frame {
-        u: PeakForceRequest::units(model),
+        u: model.units(true),
         modulus_scale: true_modulus(model, 1.0)
             .filter(|_| has_radius)
             .unwrap_or(1.0),

@@ -172,7 +172,7 @@ impl Analysis for ApproachRequest {
         CurveStudy::approach(self, model)?.run_in_memory(progress)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        let u = Self::units(model);
+        let u = model.units(false);
         let mut doc = report::approach(&model.params, c, &u);
         if let Some(s) = self.setpoint {
             let (points, dropped) = operating_points(&self.spec(model)?, c, s)?;
@@ -212,7 +212,7 @@ impl Analysis for ResonanceRequest {
         Ok(report::resonance(
             &self.computed_at(model)?,
             c,
-            &Self::units(model),
+            &model.units(true),
         ))
     }
     fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
