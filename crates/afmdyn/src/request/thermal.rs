@@ -3,7 +3,6 @@
 //! ranges and its declared cost ([`crate::analysis::thermal`] computes it).
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
-use super::fit::bad;
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::error::SimError;
@@ -94,7 +93,7 @@ pub fn check_temperature(t: f64) -> Result<(), SimError> {
     if t > lo && t <= hi {
         return Ok(());
     }
-    Err(bad(
+    Err(SimError::out_of_range(
         "temperature",
         crate::error::number(t),
         "the temperature must be above absolute zero and at most 1500 K (K)",
@@ -125,7 +124,7 @@ pub(crate) fn thermal_force(
 pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), SimError> {
     model.params.validate_fields()?;
     if model.probe.is_none() {
-        return Err(bad(
+        return Err(SimError::out_of_range(
             "probe",
             "missing",
             "the thermal spectrum is in SI: give the probe (its k, f0 and Q)",
@@ -133,7 +132,7 @@ pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), S
     }
     check_temperature(t)?;
     if !(spot > 0.0 && spot <= 1.0) {
-        return Err(bad(
+        return Err(SimError::out_of_range(
             "spot",
             crate::error::number(spot),
             "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1",
@@ -147,7 +146,7 @@ impl_request! {
     validate |r, model| {
         check_thermal(model, r.temperature(), r.spot())?;
         if let Some(f) = r.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
-            return Err(bad(
+            return Err(SimError::out_of_range(
                 "to",
                 crate::error::number(f),
                 "the highest frequency must be finite and > 0 (Hz)",
