@@ -942,8 +942,14 @@ impl ThermalExact {
 
 impl Integrator for ThermalExact {
     current_fields!();
+    /// `exact-thermal` under the linear law; `exponential-euler-thermal` under a nonlinear one
+    /// (the step is then first order in its pieces, module docs).
     fn name(&self) -> &'static str {
-        "exact-thermal"
+        if self.nonlinear() {
+            "exponential-euler-thermal"
+        } else {
+            "exact-thermal"
+        }
     }
 
     /// The sample moved to α5 = `alpha5`: the model's constant forcing and the propagator's

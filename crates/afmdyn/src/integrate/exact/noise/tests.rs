@@ -336,7 +336,7 @@ fn simulate_takes_a_temperature_with_a_probe() {
     let (_, name) = (request(Some(295.0), 0))
         .record_whole(&dmt_model, Some(&dmt), &span)
         .unwrap();
-    assert_eq!(name, "exact-thermal");
+    assert_eq!(name, "exponential-euler-thermal");
     let jkr = text.replace("law = \"dmt\"", "law = \"jkr\"");
     let jkr = Probe::parse(&jkr, "w").unwrap();
     let jkr_model = CantileverModel::new(&jkr.params).unwrap();
