@@ -578,6 +578,16 @@ fn a_thermal_scan_is_its_seeds() {
         let d = (pi_image(&dmt, &flat, &short, &s, Some(1), &Progress::new()))
             .unwrap()
             .document(0.7);
+        // the scheme's own error is said (thermal.scheme-error), once
+        let said = (d["warnings"].as_array().into_iter().flatten())
+            .filter(|w| w.as_str().unwrap_or("").contains("exponential Euler"))
+            .count();
+        assert_eq!(
+            said,
+            usize::from(temperature.is_some()),
+            "{}",
+            d["warnings"]
+        );
         row(&d, 0, "height", 1e12)
     };
     let (cold, hot) = (heights(None), heights(Some(1e-3)));

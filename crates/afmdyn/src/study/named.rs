@@ -86,7 +86,7 @@ fn simulate(request: &SimulateRequest, model: &Resolved) -> Result<Outcome, SimE
         model.probe.as_ref(),
         p,
     );
-    request.thermal_into(&mut document);
+    request.thermal_into(&mut document, &p.contact_law);
     // a trajectory from its start, as the streamed run's (`SimulateStream`)
     report::Convergence::exact("trajectory").write_into(&mut document);
     let facts = serde_json::json!({

@@ -311,6 +311,14 @@ impl ScanStudy {
         if let Some(t) = self.recipe.scan.temperature {
             img.warnings
                 .extend(crate::request::thermal::temperature_warnings(t));
+            for m in &self.job.spec.materials {
+                let (_, scheme) = crate::integrate::exact::noise::thermal_method(&m.contact_law);
+                for w in scheme {
+                    if !img.warnings.contains(&w) {
+                        img.warnings.push(w);
+                    }
+                }
+            }
         }
         // a lock-in time constant given outside the typical range: a likely unit slip, named
         // (the lever's default τ_c/4 is no slip, whatever its value)

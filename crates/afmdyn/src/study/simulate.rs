@@ -37,21 +37,20 @@ impl SimulateRequest {
         Ok((tr, integ.name()))
     }
 
-    /// With a temperature, write into the run's `doc` its `thermal` block (`temperature` K,
-    /// `seed`, `method`) and the temperature's warnings; without one leave it as it is.
-    pub(crate) fn thermal_into(&self, doc: &mut Value) {
+    /// With a temperature, write into the run's `doc` of a model of `law` its `thermal` block
+    /// (`temperature` K, `seed`, `method`) and the temperature's and the scheme's warnings
+    /// ([`crate::integrate::exact::noise::thermal_method`]); without one leave it as it is.
+    pub(crate) fn thermal_into(&self, doc: &mut Value, law: &crate::contact::ContactLaw) {
         let Some(t) = self.temperature else {
             return;
         };
+        let (method, scheme) = crate::integrate::exact::noise::thermal_method(law);
         doc["thermal"] = json!({
             "temperature": t,
             "seed": self.seed,
-            "method": "the fluctuation–dissipation theorem's white force on every mode (2 k_B T C_s), \
-                       advanced by the exact stochastic step (Van Loan 1978), switchings between \
-                       grid points located on the Gaussian bridge to h/4096 \
-                       (crate::integrate::exact::noise)",
+            "method": method,
         });
-        for w in self.warnings() {
+        for w in self.warnings().into_iter().chain(scheme) {
             match doc.get_mut("warnings").and_then(Value::as_array_mut) {
                 Some(list) => list.push(Value::from(w)),
                 None => doc["warnings"] = Value::from(vec![w]),

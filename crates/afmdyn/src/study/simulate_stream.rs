@@ -127,7 +127,8 @@ impl Analysis for SimulateStream {
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         let mut doc = report::simulate_summary(&CantileverModel::new(&model.params)?, &r.summary);
         doc["files"] = json!(self.files());
-        self.request.thermal_into(&mut doc);
+        self.request
+            .thermal_into(&mut doc, &model.params.contact_law);
         Ok(doc)
     }
     fn present(
