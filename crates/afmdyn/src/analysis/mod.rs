@@ -23,6 +23,7 @@ pub mod fit;
 pub mod fm;
 pub mod fm_loop;
 pub mod global_continuation;
+pub mod lock_in_noise;
 pub mod lyapunov;
 pub mod observables;
 pub mod peakforce;

@@ -177,6 +177,25 @@ pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
     })
 }
 
+/// [`admits`] for the law of `params`, under one harmonic drive.
+///
+/// # Errors
+/// As [`admits`]; [`SimError::OutOfRange`] naming `drive` for a multifrequency drive (the
+/// stochastic step propagates the one drive's particular solution; the lock-in's noise is that
+/// of one period).
+pub fn admits_model(params: &crate::params::Params) -> Result<(), SimError> {
+    admits(&params.contact_law)?;
+    if params.is_multifrequency() {
+        return Err(SimError::out_of_range(
+            "drive",
+            "multifrequency",
+            "thermal noise is simulated under one harmonic drive: drop temperature or the \
+             further components",
+        ));
+    }
+    Ok(())
+}
+
 /// How a thermally driven run of `law` is integrated (a document's `thermal.method`), and the
 /// warning of a nonlinear law's scheme, whose own error is not zero
 /// (module docs): the run's document and the PI scan's warnings.
@@ -210,7 +229,7 @@ pub fn thermal_method(law: &crate::contact::ContactLaw) -> (&'static str, Vec<St
 /// The lever of `model` without the sample (α4 = α6 = 0 under the linear law): the linear part
 /// the stochastic step advances exactly under a nonlinear law; `model` itself under the linear
 /// law.
-fn linear_part(model: &CantileverModel) -> Result<CantileverModel, SimError> {
+pub(crate) fn linear_part(model: &CantileverModel) -> Result<CantileverModel, SimError> {
     if model.law().is_affine() {
         return Ok(model.clone());
     }
@@ -535,15 +554,7 @@ impl ThermalExact {
         opts: &IntegratorOptions,
         force: ThermalForce,
     ) -> Result<ThermalExact, SimError> {
-        admits(model.law())?;
-        if model.params().is_multifrequency() {
-            return Err(SimError::out_of_range(
-                "drive",
-                "multifrequency",
-                "thermal noise is simulated under one harmonic drive (the stochastic step \
-                 propagates its particular solution): drop temperature or the further components",
-            ));
-        }
+        admits_model(model.params())?;
         let exact = ExactOptions {
             min_steps_per_period: opts.steps_per_period,
             cache: Some(opts.cache.clone()),

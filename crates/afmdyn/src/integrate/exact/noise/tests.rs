@@ -562,7 +562,6 @@ fn the_least_of_a_sine_over_a_window() {
 #[test]
 fn the_lock_in_output_carries_the_thermal_noise_of_its_bandwidth() {
     use crate::analysis::am_loop::{demodulate_period, LockIn};
-    use std::f64::consts::TAU;
     let p = water_linear(1e-6, 5e-9);
     let model = CantileverModel::new(&p.params).unwrap();
     let samples = 32;
@@ -596,35 +595,15 @@ fn the_lock_in_output_carries_the_thermal_noise_of_its_bandwidth() {
     };
     let l2 = p.scales.length_m.powi(2);
     let simulated = [var(&a) * l2, var(&ph) * (a_det * a_det) * l2];
-    // the linear response: ∫ S |G D|² df on a grid that resolves G's peaks (width β/(2πT))
-    let t_s = period * p.scales.time_s;
-    let f_d = 1.0 / t_s;
+    // the linear response: ∫ S |G D|² df from the thermal spectrum
+    let predicted = crate::analysis::lock_in_noise::tests::spectral_lock_in_variance(
+        &p,
+        &model,
+        samples,
+        time_constant,
+        phi,
+    );
     let beta = -(-period / time_constant).exp_m1();
-    let df = 2e-4 * f_d;
-    let f: Vec<f64> = (1..200_000).map(|i| i as f64 * df).collect();
-    let s = thermal_spectrum(&p.params, units(&p), 295.0, 1.0, &f, &Progress::default())
-        .unwrap()
-        .deflection;
-    let psi = model.params().drive_phase();
-    let predicted = [0, 1].map(|part| {
-        f.iter()
-            .zip(&s)
-            .map(|(&f, &s)| {
-                let x = TAU * f * t_s;
-                let g2 = beta * beta / (1.0 + (1.0 - beta).powi(2) - 2.0 * (1.0 - beta) * x.cos());
-                let (mut re, mut im) = (0.0, 0.0);
-                for j in 1..=samples {
-                    let u = j as f64 / samples as f64;
-                    let theta = TAU * u + psi - phi;
-                    let c = if part == 0 { theta.sin() } else { theta.cos() };
-                    re += c * (x * u).cos();
-                    im += c * (x * u).sin();
-                }
-                let d2 = (2.0 / samples as f64).powi(2) * (re * re + im * im);
-                s * g2 * d2 * df
-            })
-            .sum::<f64>()
-    });
     let rho = 1.0 - beta;
     let sigma = (2.0 * (1.0 + rho * rho) / ((1.0 - rho * rho) * periods as f64)).sqrt();
     for (name, (sim, pred)) in ["amplitude", "phase"]

@@ -1,0 +1,229 @@
+//! The lock-in's linear-response noise against two independent calculations: on the free lever,
+//! the thermal spectrum filtered by the lock-in (`spectral_lock_in_variance`, from the
+//! fluctuation–dissipation theorem's PSD of `crate::analysis::thermal`, with no integrator); at a
+//! setpoint in intermittent contact, the lock-in's output of a simulated thermally driven
+//! tapping lever (the exact stochastic step, `crate::integrate::exact::noise`).
+
+use super::*;
+use crate::analysis::am_loop::{demodulate_period, LockIn};
+use crate::analysis::progress::Progress;
+use crate::analysis::shooting::{shoot, ShootingOptions};
+use crate::analysis::thermal::{thermal_spectrum, ModelUnits, BOLTZMANN};
+use crate::integrate::exact::noise::holding_samples;
+use crate::integrate::exact::{ThermalExact, ThermalForce};
+use crate::integrate::Integrator;
+use crate::maps::StroboscopicMap;
+use crate::probe::Probe;
+use std::f64::consts::TAU;
+
+/// k_B T at 295 K in the model's energy unit of `p`.
+fn kt_model(p: &Probe) -> f64 {
+    BOLTZMANN * 295.0 / (p.scales.force_n * p.scales.length_m)
+}
+
+/// The variances (m², and m² of A δφ) of the lock-in's amplitude and phase on the free lever
+/// of `p` (`model` its model) driven to the first harmonic of phase lag `phi`, at 295 K, with
+/// `samples` per period and the time constant `time_constant` (units of τ), from the thermal
+/// spectrum S(f) alone: the output after period K is linear in the deflection's samples n(t_s),
+/// Σ_s c_s n(t_s), with c_s = β(1 − β)^k (2/M) sin(θ_j − φ) for the amplitude (cos for A δφ) at
+/// sample j of period K − k (`crate::analysis::am_loop`'s rectangle rule and first-order
+/// low-pass), so Var = ∫₀^∞ S(f) |Σ_s c_s e^{2πi f t_s}|² df (R(t) = ∫₀^∞ S(f) cos 2πft df):
+/// |G(f)|² |D(f)|² with G(f) = β/(1 − (1 − β)e^{−2πifT}) and D(f) = (2/M) Σ_j sin(θ_j − φ)
+/// e^{2πif jT/M}, summed over 0 < f < 40 f_d on a grid of 2·10⁻⁴ f_d (which resolves G's peaks,
+/// of width β/(2πT), and the lever's, of width f₀/Q for Q ≤ 500).
+pub(crate) fn spectral_lock_in_variance(
+    p: &Probe,
+    model: &CantileverModel,
+    samples: usize,
+    time_constant: f64,
+    phi: f64,
+) -> [f64; 2] {
+    let period = model.period();
+    let t_s = period * p.scales.time_s;
+    let f_d = 1.0 / t_s;
+    let beta = -(-period / time_constant).exp_m1();
+    let df = 2e-4 * f_d;
+    let f: Vec<f64> = (1..200_000).map(|i| i as f64 * df).collect();
+    let units = ModelUnits {
+        length_m: p.scales.length_m,
+        force_n: p.scales.force_n,
+        time_s: p.scales.time_s,
+    };
+    let s = thermal_spectrum(&p.params, units, 295.0, 1.0, &f, &Progress::default())
+        .unwrap()
+        .deflection;
+    let psi = model.params().drive_phase();
+    [0, 1].map(|part| {
+        f.iter()
+            .zip(&s)
+            .map(|(&f, &s)| {
+                let x = TAU * f * t_s;
+                let g2 = beta * beta / (1.0 + (1.0 - beta).powi(2) - 2.0 * (1.0 - beta) * x.cos());
+                let (mut re, mut im) = (0.0, 0.0);
+                for j in 1..=samples {
+                    let u = j as f64 / samples as f64;
+                    let theta = TAU * u + psi - phi;
+                    let c = if part == 0 { theta.sin() } else { theta.cos() };
+                    re += c * (x * u).cos();
+                    im += c * (x * u).sin();
+                }
+                let d2 = (2.0 / samples as f64).powi(2) * (re * re + im * im);
+                s * g2 * d2 * df
+            })
+            .sum::<f64>()
+    })
+}
+
+/// A point-mass lever (40 N/m, 300 kHz) of quality factor `q`, driven at resonance to 10 nm,
+/// over a linear sample of `stiffness` (N/m) at `z_c` (m).
+pub(crate) fn tapping_point_mass(q: f64, stiffness: f64, z_c: f64) -> Probe {
+    let text = format!(
+        "model = \"point-mass\"\n[cantilever]\nspring_constant = 40.0\n\
+         resonance_frequency = 300e3\nquality_factor = {q}\n[tip]\nradius = 10e-9\n\
+         [sample]\nlaw = \"linear\"\nstiffness = {stiffness}\nz_c = {z_c}\n\
+         [drive]\nfree_amplitude = 10e-9\nfrequency = 300e3\n"
+    );
+    Probe::parse(&text, "point mass").expect("probe")
+}
+
+/// The period-1 orbit of `model` near `guess` (Newton on the exact propagator's map).
+fn orbit(model: &CantileverModel, guess: &DVector<f64>) -> DVector<f64> {
+    let mut map =
+        StroboscopicMap::build(model, IntegratorOptions::default(), guess, 1).expect("map");
+    shoot(&mut map, guess, &ShootingOptions::default())
+        .expect("orbit")
+        .state
+}
+
+/// The water beam (examples/probe-water-beam.toml: three modes in water, Q₁ ≈ 2.3) over a
+/// linear sample out of reach.
+fn water_beam() -> Probe {
+    let text = include_str!("../../../../../examples/probe-water-beam.toml");
+    let (head, rest) = text.split_at(text.find("[sample]").unwrap());
+    let tail = &rest[rest.find("[drive]").unwrap()..];
+    let sample = "[sample]\nlaw = \"linear\"\nstiffness = 1.0\nz_c = 1e-6\n";
+    Probe::parse(&format!("{head}{sample}{tail}"), "water").expect("probe")
+}
+
+/// On the free lever the chain is linear and Gaussian, so its σ_A², σ_φ² must be the thermal
+/// spectrum filtered by the lock-in (`spectral_lock_in_variance`) to the quadrature errors of
+/// both (the chain's trapezoid rule, 10⁻⁵; the spectral sum's grid): within 10⁻³, for the water
+/// beam (three modes, Q₁ ≈ 2.3) and a point mass of Q = 400 in air, τ_L = 8T and T/4. With
+/// Q ≫ 1 at resonance both are S_x(f₀)/(2(τ_c + τ_L)) (module docs), k_BT/k at τ_L → 0:
+/// the point mass's within its 1/Q corrections.
+#[test]
+fn free_lever_matches_the_spectrum() {
+    let samples = crate::analysis::am_loop::LOCK_IN_SAMPLES;
+    for (name, probe) in [
+        ("water beam", water_beam()),
+        ("point mass Q = 400", tapping_point_mass(400.0, 1.0, 1e-6)),
+    ] {
+        let model = CantileverModel::new(&probe.params).unwrap();
+        let z = orbit(&model, &DVector::zeros(model.dim()));
+        let kt = kt_model(&probe);
+        let period = model.period();
+        for tl in [8.0 * period, 0.25 * period] {
+            let noise = lock_in_noise(&model, &z, kt, tl, samples).unwrap();
+            let mut integ = build(&model, IntegratorOptions::default(), 0.0, &z).unwrap();
+            let (a, phi) = demodulate_period(integ.as_mut(), &model, samples).unwrap();
+            let spectral = spectral_lock_in_variance(&probe, &model, samples, tl, phi);
+            let l2 = probe.scales.length_m.powi(2);
+            let chain = [noise.amplitude.powi(2) * l2, (noise.phase * a).powi(2) * l2];
+            for (what, (c, s)) in ["amplitude", "phase"]
+                .iter()
+                .zip(chain.iter().zip(spectral))
+            {
+                println!(
+                    "{name}, τ_L = {:.2} T, {what}: {c:.5e} m² (spectrum {s:.5e})",
+                    tl / period
+                );
+                assert!((c / s - 1.0).abs() < 1e-3, "{name} {what}: {c} vs {s}");
+            }
+            if name.starts_with("point") {
+                // the slow-flow closed form: σ_A² = k_BT/k · τ_c/(τ_c + τ_L), τ_c = 2Q/ω₀
+                let tau_c = 2.0 * 400.0 / model.omega();
+                let k = probe.calibration.spring_constant;
+                let closed = BOLTZMANN * 295.0 / k * tau_c / (tau_c + tl);
+                assert!(
+                    (chain[0] / closed - 1.0).abs() < 0.02,
+                    "{} vs {closed}",
+                    chain[0]
+                );
+            }
+        }
+    }
+}
+
+/// At a setpoint in intermittent contact (A/A₀ ≈ 0.6 over a 40 N/m linear sample, Q = 100) the
+/// chain's σ_A and σ_φ against the lock-in's output of the thermally driven lever itself (the
+/// exact stochastic step, the switchings the noise moves located on the Gaussian bridge),
+/// 40 000 periods after a burn-in, τ_L = 8T: within 4 standard errors of the simulated variance
+/// (batch means over 40 batches). The noise σ ≈ 10 pm is 10⁻³ of the amplitude, where the
+/// linear response holds.
+#[test]
+fn at_a_setpoint_the_simulated_lock_in_agrees() {
+    let samples = crate::analysis::am_loop::LOCK_IN_SAMPLES;
+    let probe = tapping_point_mass(100.0, 40.0, 6e-9);
+    let model = CantileverModel::new(&probe.params).unwrap();
+    // settle from rest, then the orbit
+    let mut integ = build(
+        &model,
+        IntegratorOptions::default(),
+        0.0,
+        &DVector::zeros(2),
+    )
+    .unwrap();
+    crate::integrate::advance(integ.as_mut(), 400.0 * model.period()).unwrap();
+    let z = orbit(&model, integ.state());
+    let kt = kt_model(&probe);
+    let period = model.period();
+    let tl = 8.0 * period;
+    let noise = lock_in_noise(&model, &z, kt, tl, samples).unwrap();
+    let opts = IntegratorOptions {
+        steps_per_period: holding_samples(1, samples),
+        ..IntegratorOptions::default()
+    };
+    let mut it = ThermalExact::new(&model, &opts, ThermalForce::new(kt, 11)).unwrap();
+    it.reset(0.0, &z).unwrap();
+    let (a_det, phi) = demodulate_period(&mut it.clone(), &model, samples).unwrap();
+    let free = crate::analysis::observables::free_response(&model)
+        .unwrap()
+        .amplitude;
+    println!("A/A0 = {:.3}", a_det / free);
+    assert!(
+        a_det < 0.7 * free && a_det > 0.4 * free,
+        "{a_det} of {free}"
+    );
+    let mut lock = LockIn::new(tl, period, a_det, phi);
+    let (burn, batches, per) = (400, 40, 1000);
+    let mut series = [Vec::new(), Vec::new()];
+    for k in 0..burn + batches * per {
+        let (ak, pk) = demodulate_period(&mut it, &model, samples).unwrap();
+        lock.update(ak, pk);
+        let z = it.state().clone();
+        it.reset(0.0, &z).unwrap();
+        if k >= burn {
+            series[0].push(lock.amplitude());
+            series[1].push(lock.phase());
+        }
+    }
+    // each batch's mean square about the whole run's mean: their mean is the variance, their
+    // spread its standard error (batches much longer than the output's correlation)
+    let var = series.map(|s| {
+        let m = s.iter().sum::<f64>() / s.len() as f64;
+        s.chunks(per)
+            .map(|b| b.iter().map(|x| (x - m).powi(2)).sum::<f64>() / per as f64)
+            .collect::<Vec<f64>>()
+    });
+    let predicted = [noise.amplitude.powi(2), noise.phase.powi(2)];
+    for (what, (v, pred)) in ["amplitude", "phase"].iter().zip(var.iter().zip(predicted)) {
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let se = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        println!("{what}: simulated {mean:.4e} ± {se:.2e}, linear response {pred:.4e}");
+        assert!(
+            (mean - pred).abs() < 4.0 * se,
+            "{what}: {mean} ± {se} vs {pred}"
+        );
+    }
+}
