@@ -72,12 +72,15 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "schema": "approach",
         "flatten": {"curve": "CurveFlags"},
         "omit": ["average", "exact"],
-        "args": {"setpoint": 'value_name = "RATIO"'},
+        "args": {"setpoint": 'value_name = "RATIO"', "temperature": 'value_name = "K"',
+                 "time_constant": 'value_name = "S"'},
     },
     "BimodalFlags": {
         "schema": "approach",
         "flatten": {"curve": "CurveFlags"},
         "order": ["setpoint", "average", "exact"],
+        # the lock-in's thermal noise is computed under one harmonic drive
+        "omit": ["temperature", "time_constant"],
         "args": {"setpoint": 'value_name = "RATIO"', "exact": 'conflicts_with = "average"'},
     },
     "ResonanceFlags": {

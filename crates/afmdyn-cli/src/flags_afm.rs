@@ -247,17 +247,17 @@ impl FitMapFlags {
 #[derive(Debug, Clone, Args)]
 pub struct ThermalFlags {
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
-    pub temperature: Option<f64>,
+    #[arg(long, default_value = "295.0", allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
+    pub temperature: f64,
     /// `--spot`: the request's `spot`.
-    #[arg(long, allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the lever's length from its base (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.")]
-    pub spot: Option<f64>,
+    #[arg(long, default_value = "1.0", allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the lever's length from its base (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.")]
+    pub spot: f64,
     /// `--to`: the request's `to`.
     #[arg(long, allow_hyphen_values = true, help = "The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's frequency, at least 3 f₀. With --probe a unit may follow (300kHz).")]
     pub to: Option<Quantity>,
     /// `--points`: the request's `points`.
-    #[arg(long, value_name = "N", help = "The number of frequencies, evenly spaced from to/points to --to (1 to 10⁷; default 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the spectrum; each mode's share is exact whatever the spacing.")]
-    pub points: Option<usize>,
+    #[arg(long, default_value = "4096", value_name = "N", help = "The number of frequencies, evenly spaced from to/points to --to (1 to 10⁷; default 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the spectrum; each mode's share is exact whatever the spacing.")]
+    pub points: usize,
 }
 
 impl ThermalFlags {
@@ -294,11 +294,11 @@ pub struct CalibrateFlags {
     #[arg(long, value_name = "FILE.csv", help = "A force curve on a hard surface: a CSV with the columns height (m, the piezo height, decreasing into the surface) and deflection (V), whose contact slope gives the InvOLS.")]
     pub force_curve: Option<String>,
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
-    pub temperature: Option<f64>,
+    #[arg(long, default_value = "295.0", allow_negative_numbers = true, help = "The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a value in °C?).")]
+    pub temperature: f64,
     /// `--spot`: the request's `spot`.
-    #[arg(long, allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤ 1; default 1): the correction factors are the model's there.")]
-    pub spot: Option<f64>,
+    #[arg(long, default_value = "1.0", allow_negative_numbers = true, help = "The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤ 1; default 1): the correction factors are the model's there.")]
+    pub spot: f64,
     /// `--peaks`: the request's `peaks`.
     #[arg(long, value_name = "N", help = "The number of peaks fitted, the modes from the first (1 to the probe's number of modes; default every mode of the probe whose peak lies in the spectrum).")]
     pub peaks: Option<usize>,

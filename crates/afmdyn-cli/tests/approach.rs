@@ -489,3 +489,65 @@ fn setpoint_operating_points_are_orbits_of_the_curve() {
         }
     }
 }
+
+/// `approach --temperature`: σ_A in m at every point of both sweeps, the `"thermal"` block (the
+/// lock-in's time constant and bandwidth), a warning for a temperature in °C, and the refusals
+/// (no probe; a time constant alone) as one line with exit 2.
+#[test]
+fn approach_temperature_gives_the_lock_ins_noise() {
+    let probe = "examples/probe-rtespa300-polystyrene.toml";
+    let doc = json(&[
+        "approach",
+        "--probe",
+        probe,
+        "--points",
+        "6",
+        "--no-branches",
+        "--temperature",
+        "295",
+        "--time-constant",
+        "1e-3",
+        "--json",
+    ]);
+    let t = &doc["thermal"];
+    assert_eq!(t["temperature"], 295.0);
+    assert_eq!(t["time_constant"], 1e-3);
+    // (f_d/2) β/(2 − β) ≈ 1/(4τ_L) for τ_L ≫ T
+    assert!((t["bandwidth"].as_f64().unwrap() / 250.0 - 1.0).abs() < 1e-3);
+    for sweep in ["approach", "retract"] {
+        let s = doc[sweep]["amplitude_noise"].as_array().unwrap();
+        assert_eq!(s.len(), 6);
+        // picometres: k_BT/k = (10 pm)² for 40 N/m
+        assert!(s
+            .iter()
+            .all(|v| v.as_f64().is_some_and(|v| v > 1e-13 && v < 2e-11)));
+    }
+    let warm = json(&[
+        "approach",
+        "--probe",
+        probe,
+        "--points",
+        "3",
+        "--no-branches",
+        "--temperature",
+        "22",
+        "--json",
+    ]);
+    let said = warm["warnings"].to_string();
+    assert!(said.contains("written in °C?"), "{said}");
+    bad_input(
+        &["approach", "--temperature", "295", "--json"],
+        "temperature",
+    );
+    bad_input(
+        &[
+            "approach",
+            "--probe",
+            probe,
+            "--time-constant",
+            "1e-3",
+            "--json",
+        ],
+        "time-constant",
+    );
+}

@@ -133,3 +133,25 @@ def test_traces_equal_the_command_line(cli_json, tmp_path):
     assert np.allclose(gap, gap[:, :1], rtol=0, atol=1e-18)
     with pytest.raises(ValueError, match="traces = 1"):
         afmdyn.approach(probe=str(PROBE), traces=1)
+
+
+def test_approach_temperature_gives_the_lock_in_noise(cli_json):
+    """``temperature=``: the dataset gains ``amplitude_noise`` (m) and ``phase_noise_deg``
+    over (sweep, z_c), the command line's numbers; far from the sample σ_A is the free lever's
+    √(k_BT/k · τ_c/(τ_c + τ_L)) (the lock-in's default τ_L = τ_c/4)."""
+    ds = afmdyn.approach(afmdyn.Params.from_probe(PROBE), probe=PROBE, from_=11e-9, to=5e-9,
+                         points=5, branches=False, temperature=295.0)
+    ref = cli_json(
+        "approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9", "--points", "5",
+        "--no-branches", "--temperature", "295", "--files", "none",
+    )
+    sigma = ds.amplitude_noise.sel(sweep="approach").values.tolist()
+    assert sigma == ref["approach"]["amplitude_noise"]
+    assert ds.amplitude_noise.attrs["units"] == "m"
+    assert ds.phase_noise_deg.attrs["units"] == "degree"
+    assert ds.afmdyn.to_dict()["thermal"]["temperature"] == 295.0
+    k = ref["si"]["calibration"]["spring_constant"]
+    free = (1.380649e-23 * 295.0 / k * 0.8) ** 0.5
+    assert sigma[0] == pytest.approx(free, rel=0.01)
+    with pytest.raises(ValueError, match="time_constant"):
+        afmdyn.approach(afmdyn.Params.from_probe(PROBE), probe=PROBE, time_constant=1e-3)

@@ -344,3 +344,105 @@ fn traces_are_the_steady_cycles_of_the_curve() {
         }
     }
 }
+
+/// `approach` with a temperature (the RTESPA-300 over polystyrene, a DMT sample): the
+/// sweeps gain σ_A and σ_φ at every point (`amplitude_noise`, `phase_noise_deg`), and the
+/// document a `"thermal"` block with the lock-in's time constant. Far from the sample the
+/// lever is free, and with Q ≫ 1 at resonance σ_A² = (k_BT/k) τ_c/(τ_c + τ_L), τ_c = 2Q/ω₀ (the
+/// slow amplitude's first-order response behind the lock-in's first-order filter; equipartition
+/// k_BT/k at τ_L → 0): within 1 % (its 1/Q corrections), at the default τ_L = τ_c/4 and at a
+/// given τ_L = 1 ms. In the repulsive regime the sample stiffens the amplitude, so σ_A falls
+/// below the free lever's. Refused: without a probe, a time constant without a temperature,
+/// a law with memory (JKR).
+#[test]
+fn a_temperature_gives_the_lock_ins_thermal_noise() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::{run, ApproachRequest, CurveRequest, Resolved};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/probe-rtespa300-polystyrene.toml");
+    let probe = Probe::load(&path).expect("example probe");
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe.clone()),
+    };
+    let (k, q, f0) = (
+        probe.calibration.spring_constant,
+        probe.calibration.quality_factor,
+        probe.calibration.resonance_frequency,
+    );
+    let tau_c = 2.0 * q / (std::f64::consts::TAU * f0);
+    let kt = 1.380_649e-23 * 295.0;
+    for (tc, tl) in [(None, tau_c / 4.0), (Some(1e-3), 1e-3)] {
+        let request = ApproachRequest {
+            curve: CurveRequest {
+                points: Some(12),
+                branches: false,
+                ..CurveRequest::default()
+            },
+            temperature: Some(295.0),
+            time_constant: tc,
+            ..ApproachRequest::default()
+        };
+        let doc = run(&request, &model, &Progress::new()).unwrap().json;
+        let t = &doc["thermal"];
+        assert!((t["time_constant"].as_f64().unwrap() / tl - 1.0).abs() < 1e-9);
+        let sigma: Vec<f64> = doc["approach"]["amplitude_noise"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(sigma.len(), 12);
+        assert_eq!(
+            doc["retract"]["amplitude_noise"].as_array().unwrap().len(),
+            12
+        );
+        let free = (kt / k * tau_c / (tau_c + tl)).sqrt();
+        assert!(
+            (sigma[0] / free - 1.0).abs() < 0.01,
+            "{} vs {free}",
+            sigma[0]
+        );
+        // the last point is deep in the repulsive regime
+        assert!(sigma[11] < 0.5 * free, "{} vs {free}", sigma[11]);
+        let phase = doc["approach"]["phase_noise_deg"][0].as_f64().unwrap();
+        let a = doc["approach"]["amplitude"][0].as_f64().unwrap();
+        // free: the phase quadrature carries the same noise, σ_φ = σ/A
+        assert!((phase.to_radians() * a / free - 1.0).abs() < 0.01);
+    }
+    let refused = |model: &Resolved, request: ApproachRequest| {
+        run(&request, model, &Progress::new()).unwrap_err()
+    };
+    let hot = ApproachRequest {
+        temperature: Some(295.0),
+        ..ApproachRequest::default()
+    };
+    let e = refused(&Resolved::plain(probe.params), hot.clone());
+    assert!(
+        matches!(&e, SimError::OutOfRange { name, .. } if *name == "temperature"),
+        "{e}"
+    );
+    let e = refused(
+        &model,
+        ApproachRequest {
+            time_constant: Some(1e-3),
+            ..ApproachRequest::default()
+        },
+    );
+    assert!(
+        matches!(&e, SimError::OutOfRange { name, .. } if *name == "time_constant"),
+        "{e}"
+    );
+    let jkr = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-jkr-polymer.toml"),
+    )
+    .expect("example probe");
+    let e = refused(
+        &Resolved {
+            params: jkr.params,
+            probe: Some(jkr),
+        },
+        hot,
+    );
+    assert!(matches!(e, SimError::Unsupported { .. }), "{e}");
+}

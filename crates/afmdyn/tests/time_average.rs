@@ -149,6 +149,7 @@ fn commensurate_orbits_and_time_average_agree() {
         setpoint: None,
         average: true,
         exact: false,
+        ..ApproachRequest::default()
     };
     let model = Resolved {
         params: p,

@@ -338,6 +338,8 @@ ApproachRequest = TypedDict(
         "points": Optional[int],  # default null
         "setpoint": Optional[float],  # default null
         "step": Optional[float],  # default null
+        "temperature": Optional[float],  # default null
+        "time_constant": Optional[float],  # default null
         "to": Optional[float],  # default null
         "tolerance": float,  # default 1e-10
         "traces": Optional[int],  # default null
@@ -471,9 +473,9 @@ FitMapRequest = TypedDict(
 ThermalRequest = TypedDict(
     "ThermalRequest",
     {
-        "points": Optional[int],  # default null
-        "spot": Optional[float],  # default null
-        "temperature": Optional[float],  # default null
+        "points": int,  # default 4096
+        "spot": float,  # default 1.0
+        "temperature": float,  # default 295.0
         "to": Optional[float],  # default null
     },
     total=False,
@@ -490,8 +492,8 @@ CalibrateRequest = TypedDict(
         "psd": Optional[str],  # default null
         "signal": Optional[Literal["apparent-deflection", "deflection"]],  # default null
         "spectral_density": List[float],  # default []
-        "spot": Optional[float],  # default null
-        "temperature": Optional[float],  # default null
+        "spot": float,  # default 1.0
+        "temperature": float,  # default 295.0
         "volts": bool,  # default false
     },
     total=False,

@@ -147,6 +147,8 @@ def approach(
     points: Optional[int] = None,
     setpoint: Optional[float] = None,
     step: Optional[float] = None,
+    temperature: Optional[float] = None,
+    time_constant: Optional[float] = None,
     to: Optional[float] = None,
     tolerance: float = 1e-10,
     traces: Optional[int] = None,
@@ -178,6 +180,17 @@ def approach(
             a ``"setpoint"`` block with the operating points where the curve's amplitude
             equals it on each stable branch (``analysis::setpoint``).
         step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
+        temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
+            200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
+            the document gains a ``"thermal"`` block: at every stable period-1 point of both
+            sweeps the standard deviations of the lock-in's amplitude and phase under the
+            lever's thermal force, by linear response about the orbit, noise within each
+            period, switchings and the lock-in's filter included
+            (``analysis::lock_in_noise``). Needs the probe's SI units; the laws with memory
+            (JKR, capillary, SLS, impact) and a multifrequency drive are refused.
+        time_constant: The lock-in's low-pass time constant τ_L (s; with ``temperature``), ≥
+            0 and at most 1 000 s; ``None``: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time
+            (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).
         to: Other end (front-end unit): z_c where the approach ends and the retract starts
             (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
         tolerance: Tolerance of the adaptive integrator, in (0, 1e-3).
@@ -654,9 +667,9 @@ def thermal(
     params: Optional[Params] = None,
     /,
     *,
-    points: Optional[int] = None,
-    spot: Optional[float] = None,
-    temperature: Optional[float] = None,
+    points: int = 4096,
+    spot: float = 1.0,
+    temperature: float = 295.0,
     to: Optional[float] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
@@ -714,8 +727,8 @@ def calibrate(
     psd: Optional[str] = None,
     signal: Optional[str] = None,
     spectral_density: Optional[Sequence[float]] = None,
-    spot: Optional[float] = None,
-    temperature: Optional[float] = None,
+    spot: float = 1.0,
+    temperature: float = 295.0,
     volts: bool = False,
     progress: ProgressArg = None,
     **model: Unpack[Model],

@@ -3,7 +3,7 @@
 //! Python's `afmdyn.approach` and `afmdyn.resonance` return as a dataset.
 
 use crate::layout::{Layout, Values, Variable};
-use crate::report::CURVE_COLUMNS;
+use crate::report::{CURVE_COLUMNS, NOISE_COLUMNS};
 use serde_json::Value;
 use std::collections::HashMap;
 
@@ -110,10 +110,11 @@ pub(crate) fn curve_layout(doc: &Value) -> Layout {
     let x_unit = unit(units, Some(x_kind));
     let abscissa = (x, x_unit.as_str(), x_name);
     let grid = numbers(&first[x]);
-    // the curve's columns; under a multifrequency drive each component's (amplitude_i,
-    // phase_i_deg, …) too
-    let mut columns: Vec<Column> = CURVE_COLUMNS
-        .iter()
+    // the curve's columns; with a temperature σ_A and σ_φ of the lock-in; under a
+    // multifrequency drive each component's (amplitude_i, phase_i_deg, …) too
+    let noise = first.get(NOISE_COLUMNS[0].name).is_some();
+    let mut columns: Vec<Column> = (CURVE_COLUMNS.iter())
+        .chain(NOISE_COLUMNS.iter().filter(|_| noise))
         .map(|c| {
             let kind = c.kind.key().map(Into::into);
             (c.name.into(), kind, c.long_name.into())

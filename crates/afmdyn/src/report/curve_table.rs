@@ -6,9 +6,10 @@
 
 use super::{
     component_columns, component_row, curve_column_index, curve_row, CurveUnits, UnitKind,
-    CURVE_COLUMNS,
+    CURVE_COLUMNS, NOISE_COLUMNS,
 };
 use crate::analysis::continuation::BranchEvent;
+use crate::analysis::lock_in_noise::LockInNoise;
 use crate::analysis::observables::Observables;
 use crate::analysis::stepped::SteppedCurve;
 use crate::layout::files::Column;
@@ -44,6 +45,10 @@ pub(crate) fn curve_table(
         .map_or(0, |p| p.observables.components.len());
     for (name, kind, what) in component_columns(count) {
         cols.push(Column::new(name, u.unit(kind), what));
+    }
+    // with a temperature the lock-in's σ_A and σ_φ, after them (NaN on the branches)
+    for c in NOISE_COLUMNS.iter().filter(|_| c.noise.is_some()) {
+        cols.push(Column::new(c.name, u.unit(c.kind), c.long_name));
     }
     if dforce {
         (rows(c, x, u, base), cols)
@@ -137,8 +142,12 @@ fn row(point: &TablePoint, u: &CurveUnits) -> Vec<f64> {
 fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params) -> Vec<Vec<f64>> {
     let omega = |v: f64| base.with(c.param, v).omega;
     let mut out = Vec::new();
-    for (code, sweep) in [(0.0, &c.first), (1.0, &c.second)] {
-        for p in sweep {
+    let noise = |s: Option<&LockInNoise>| match s {
+        Some(n) => vec![n.amplitude * u.length, n.phase.to_degrees()],
+        None => vec![f64::NAN; 2],
+    };
+    for (k, (code, sweep)) in [(0.0, &c.first), (1.0, &c.second)].into_iter().enumerate() {
+        for (i, p) in sweep.iter().enumerate() {
             let point = TablePoint {
                 x: x(p.value),
                 observables: &p.observables,
@@ -148,7 +157,11 @@ fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params)
                 period: p.period,
                 event: None,
             };
-            out.push(row(&point, u));
+            let mut r = row(&point, u);
+            if let Some(n) = &c.noise {
+                r.extend(noise(n[k].get(i)));
+            }
+            out.push(r);
         }
     }
     for (k, b) in c.branches.iter().enumerate() {
@@ -163,7 +176,11 @@ fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params)
                 period: Some(bp.period),
                 event: bp.event,
             };
-            out.push(row(&point, u));
+            let mut r = row(&point, u);
+            if c.noise.is_some() {
+                r.extend(noise(None));
+            }
+            out.push(r);
         }
     }
     out

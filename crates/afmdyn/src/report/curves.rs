@@ -2,6 +2,7 @@
 //! reported block): the [`CURVE_COLUMNS`] of each point in its [`CurveUnits`].
 
 use super::*;
+use crate::analysis::lock_in_noise::LockInNoise;
 
 /// The [`CURVE_COLUMNS`] of one orbit's observables in `u`'s units: A, A/A₀ (A₀ the free
 /// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
@@ -149,12 +150,28 @@ fn columns<'a>(
     m
 }
 
-fn sweep_doc(x: &Abscissa<'_>, points: &[CurvePoint], u: &CurveUnits) -> Value {
+fn sweep_doc(
+    x: &Abscissa<'_>,
+    points: &[CurvePoint],
+    noise: Option<&[LockInNoise]>,
+    u: &CurveUnits,
+) -> Value {
     let mut m = columns(
         x,
         points.iter().map(|p| (p.value, &p.observables, p.stable)),
         u,
     );
+    if let Some(n) = noise {
+        let [a, p] = NOISE_COLUMNS.map(|c| c.name);
+        m.insert(
+            a.into(),
+            json!(n.iter().map(|s| s.amplitude * u.length).collect::<Vec<_>>()),
+        );
+        m.insert(
+            p.into(),
+            json!(n.iter().map(|s| s.phase.to_degrees()).collect::<Vec<_>>()),
+        );
+    }
     m.insert(
         "period".into(),
         json!(points.iter().map(|p| p.period).collect::<Vec<_>>()),
@@ -237,8 +254,8 @@ fn curve_doc(
         "units": u.names(),
         "scales": {"length": u.length, "force": u.force, "energy": u.energy, "time": u.time,
                    "hz_per_omega": u.hz_per_omega},
-        names.0: sweep_doc(&x, &c.first, u),
-        names.1: sweep_doc(&x, &c.second, u),
+        names.0: sweep_doc(&x, &c.first, c.noise.as_ref().map(|n| &n[0][..]), u),
+        names.1: sweep_doc(&x, &c.second, c.noise.as_ref().map(|n| &n[1][..]), u),
         "branches": branches,
         "folds": c.folds.iter().map(|&f| (x.1)(f)).collect::<Vec<_>>(),
         "bistable": c.bistable.iter().map(|&(a, b)| {
@@ -477,6 +494,35 @@ pub(crate) fn audit_missing(doc: &mut Value, what: &'static str) -> Result<(), c
 pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let x = z_c_of(params, u);
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
+}
+
+/// The `"thermal"` block of `afmdyn approach --temperature T --json`
+/// ([`crate::analysis::lock_in_noise`]; the sweeps' [`NOISE_COLUMNS`] carry σ_A and σ_φ):
+/// `temperature` (K), `time_constant` (the lock-in's τ_L, in `u`'s time), `bandwidth` (its
+/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, Hz with a probe, else per
+/// unit τ) and `method`.
+pub(crate) fn thermal_noise(
+    params: &Params,
+    temperature: f64,
+    time_constant: f64,
+    u: &CurveUnits,
+) -> Value {
+    let period = params.period();
+    let beta = if time_constant > 0.0 {
+        -(-period / time_constant).exp_m1()
+    } else {
+        1.0
+    };
+    json!({
+        "temperature": temperature,
+        "time_constant": time_constant * u.time,
+        "bandwidth": 0.5 / (period * u.time) * beta / (2.0 - beta),
+        "method": "the lock-in's amplitude and phase noise by linear response about each \
+                   orbit: the variational flow with its saltations, the fluctuation–dissipation \
+                   theorem's white force and the lock-in's filter as one linear chain per \
+                   period, its stationary covariance (crate::analysis::lock_in_noise)",
+        "columns": NOISE_COLUMNS.iter().map(|c| c.name).collect::<Vec<_>>(),
+    })
 }
 
 /// The abscissa of an approach document: z_c ([`crate::analysis::approach::rest_distance`]) of

@@ -291,6 +291,22 @@ const fn curve_column(name: &'static str, kind: UnitKind, long_name: &'static st
     }
 }
 
+/// The per-point columns of an approach with a temperature
+/// ([`crate::analysis::lock_in_noise`]), after [`CURVE_COLUMNS`]: NaN (null) where a point is
+/// not a stable period-1 orbit.
+pub(crate) const NOISE_COLUMNS: [CurveColumn; 2] = [
+    curve_column(
+        "amplitude_noise",
+        UnitKind::Length,
+        "standard deviation of the lock-in amplitude under the thermal force (linear response)",
+    ),
+    curve_column(
+        "phase_noise_deg",
+        UnitKind::Phase,
+        "standard deviation of the lock-in phase under the thermal force (linear response)",
+    ),
+];
+
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
 pub(crate) const CURVE_COLUMNS: [CurveColumn; 13] = [
     curve_column(

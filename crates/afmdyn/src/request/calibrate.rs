@@ -6,7 +6,7 @@
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
 use super::fit::MAX_FIT_ROWS;
 use super::limits::Cost;
-use super::thermal::{check_thermal, temperature_warnings, DEFAULT_TEMPERATURE};
+use super::thermal::{check_thermal, DEFAULT_TEMPERATURE};
 use crate::analysis::calibration::Signal;
 use crate::error::SimError;
 
@@ -37,10 +37,10 @@ request! {
         pub force_curve: Option<String>,
         /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
         /// value in °C?).
-        pub temperature: Option<f64>,
+        pub temperature: f64 = DEFAULT_TEMPERATURE,
         /// The optical lever's laser spot ξ_s, a fraction of the length from the base (0 < ξ_s ≤
         /// 1; default 1): the correction factors are the model's there.
-        pub spot: Option<f64>,
+        pub spot: f64 = 1.0,
         /// The number of peaks fitted, the modes from the first (1 to the probe's number of modes;
         /// default every mode of the probe whose peak lies in the spectrum).
         pub peaks: Option<usize>,
@@ -53,16 +53,6 @@ request! {
 }
 
 impl CalibrateRequest {
-    /// The temperature (K).
-    pub fn temperature(&self) -> f64 {
-        self.temperature.unwrap_or(DEFAULT_TEMPERATURE)
-    }
-
-    /// The laser spot (a fraction of the length).
-    pub fn spot(&self) -> f64 {
-        self.spot.unwrap_or(1.0)
-    }
-
     /// What the spectrum measures.
     pub fn signal(&self) -> Signal {
         self.signal.unwrap_or(Signal::ApparentDeflection)
@@ -71,11 +61,6 @@ impl CalibrateRequest {
     /// The bands searched, a pair [lo, hi] (Hz) per mode.
     pub fn bands(&self) -> Vec<[f64; 2]> {
         self.bands.chunks_exact(2).map(|b| [b[0], b[1]]).collect()
-    }
-
-    /// The warning of a temperature outside the typical range.
-    pub fn warnings(&self) -> Vec<String> {
-        temperature_warnings(self.temperature())
     }
 
     /// The rows of the spectrum: the columns', or the most a file may have.
@@ -118,7 +103,7 @@ impl CalibrateRequest {
 impl_request! {
     CalibrateRequest, "calibrate", advice = "give a shorter spectrum";
     validate |r, model| {
-        check_thermal(model, r.temperature(), r.spot())?;
+        check_thermal(model, r.temperature, r.spot)?;
         let n = model.params.modes;
         let refuse = |name, value: String, why| Err(SimError::out_of_range(name, value, why));
         match (&r.psd, r.frequency.is_empty() && r.spectral_density.is_empty()) {

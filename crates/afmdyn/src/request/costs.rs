@@ -151,10 +151,15 @@ pub(crate) fn recorded_sample_bytes(params: &Params) -> f64 {
 /// 2000; `tests/door.rs`).
 pub(crate) const TRACE_GROWTH: f64 = 3.5;
 
+/// The work of the lock-in's thermal noise at one point of a stepped curve, in drive periods of
+/// the model per mode (`stepped_cost`): its period of variational flows and the products of its
+/// chain, about eight periods' worth.
+const NOISE_PERIODS: f64 = 8.0;
+
 /// The cost of a stepped curve (`approach`, `resonance`): every point's steady state (one way,
 /// and back with branches: each value twice), up to `max_branch_points` Newton solves of the
-/// largest period per branch, and the traces' worst case ([`super::curves::trace_bytes`] ×
-/// [`TRACE_GROWTH`]).
+/// largest period per branch, the traces' worst case ([`super::curves::trace_bytes`] ×
+/// [`TRACE_GROWTH`]) and the lock-in's thermal noise at every point ([`NOISE_PERIODS`]).
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
@@ -183,9 +188,15 @@ pub(crate) fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
     };
     // a point: its state, observables and orbit (a few hundred bytes)
     let point = 4.0 * state_bytes(p) + 512.0;
+    // the lock-in's thermal noise at every point of both sweeps: a period of variational flows
+    // in 512 parts and the chain's (2N + 4)² products (crate::analysis::lock_in_noise)
+    let noise = match spec.noise {
+        Some(_) => 2.0 * points * NOISE_PERIODS * p.modes as f64,
+        None => 0.0,
+    };
     Ok(Cost {
         bytes: MODEL_BYTES + ways * points * point + traces,
-        work: ways * points * search + branch,
+        work: ways * points * search + branch + noise,
     })
 }
 

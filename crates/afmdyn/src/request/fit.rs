@@ -369,7 +369,7 @@ impl FitRequest {
                 )),
             };
         };
-        super::thermal::check_temperature(t)?;
+        super::limits::check_temperature(t)?;
         let number = crate::error::number;
         if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
             return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));

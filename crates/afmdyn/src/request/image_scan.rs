@@ -17,8 +17,9 @@
 //! 0.74 Hz).
 
 use super::image::{ImageRequest, SampleMap};
+use super::limits::positive;
 use crate::analysis::am_loop::{FeedbackGains, LOCK_IN_SAMPLES};
-use crate::error::{number, SimError};
+use crate::error::{number, within, SimError};
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 
@@ -77,7 +78,7 @@ impl PiScan {
         probe: &Probe,
     ) -> Result<Option<crate::integrate::exact::ThermalForce>, SimError> {
         (self.temperature)
-            .map(|t| super::thermal::thermal_force(t, self.seed, probe))
+            .map(|t| super::limits::thermal_force(t, self.seed, Some(probe)))
             .transpose()
     }
 }
@@ -97,22 +98,33 @@ pub struct ScanRecipe {
     pub scan: PiScan,
 }
 
-/// A positive finite SI setting, or an error naming it.
-fn positive(
-    name: &'static str,
-    v: f64,
-    zero_ok: bool,
-    allowed: &'static str,
-) -> Result<f64, SimError> {
-    if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
-        Ok(v)
-    } else {
-        Err(SimError::out_of_range(
-            name,
-            crate::error::number(v),
-            allowed,
-        ))
+/// The lock-in's time constant τ_L (s) under `probe`: `given`, a finite time ≥ 0 within the
+/// lock-in's physical range (section `feedback` of [`crate::probe::ranges`]), or the lever's
+/// default τ_c/4 ([`FeedbackGains::for_lever`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `time_constant`.
+pub(crate) fn lock_in_time_constant(probe: &Probe, given: Option<f64>) -> Result<f64, SimError> {
+    let t_s = probe.scales.time_s;
+    let Some(v) = given else {
+        let (q, f0) = (
+            probe.calibration.quality_factor,
+            probe.calibration.resonance_frequency,
+        );
+        return Ok(
+            FeedbackGains::for_lever(q, std::f64::consts::TAU * f0 * t_s).time_constant * t_s,
+        );
+    };
+    within(
+        "time_constant",
+        v,
+        0.0..f64::INFINITY,
+        "must be a finite time ≥ 0 (s)",
+    )?;
+    if let Some(why) = crate::probe::ranges::refusal("feedback", "time_constant", v) {
+        return Err(SimError::out_of_range("time_constant", number(v), why));
     }
+    Ok(v)
 }
 
 /// The settings of a PI scan of `req` over `map` under `probe` (the lever's defaults where
@@ -136,23 +148,14 @@ pub(crate) fn resolve(
     );
     let lever = FeedbackGains::for_lever(q, std::f64::consts::TAU * f0 * t_s);
     let (kp, ki) = match scan.gains {
-        Some((p, i)) => (
-            positive("gains", p, true, "K_P must be a finite number ≥ 0")?,
-            positive("gains", i, false, "K_I must be a finite rate > 0 (1/s)")?,
-        ),
+        Some((p, i)) => {
+            within("gains", p, 0.0..f64::INFINITY, "K_P must be finite and ≥ 0")?;
+            positive("gains", i, "K_I must be a finite rate > 0 (1/s)")?;
+            (p, i)
+        }
         None => (lever.proportional, lever.integral / t_s),
     };
-    let tc = match scan.time_constant {
-        Some(v) => {
-            let v = positive("time_constant", v, true, "must be a finite time ≥ 0 (s)")?;
-            // the lock-in's physical range (probe::ranges, section `feedback`)
-            if let Some(why) = crate::probe::ranges::refusal("feedback", "time_constant", v) {
-                return Err(SimError::out_of_range("time_constant", number(v), why));
-            }
-            v
-        }
-        None => lever.time_constant * t_s,
-    };
+    let tc = lock_in_time_constant(probe, scan.time_constant)?;
     let gains = FeedbackGains {
         proportional: kp,
         integral: ki * t_s,
@@ -162,12 +165,14 @@ pub(crate) fn resolve(
     let pixels = req.pixels;
     let fastest = f_drive / (2.0 * pixels as f64);
     let scan_rate = match scan.scan_rate {
-        Some(r) => positive(
-            "scan_rate",
-            r,
-            false,
-            "must be a finite rate > 0 (Hz, lines per second)",
-        )?,
+        Some(r) => {
+            positive(
+                "scan_rate",
+                r,
+                "must be a finite rate > 0 (Hz, lines per second)",
+            )?;
+            r
+        }
         None => ki / (2.0 * pixels as f64 * PIXEL_LOOP_TIMES),
     };
     if scan_rate > fastest && scan.scan_rate.is_none() {

@@ -21,6 +21,7 @@ pub(crate) const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * GIB;
 pub(crate) const MAX_TRACE_BYTES: f64 = GIB;
 /// Bytes of one trace sample: deflection, distance and force, 8 bytes each.
 pub(crate) const TRACE_BYTES_PER_SAMPLE: f64 = 24.0;
+use crate::error::SimError;
 pub use crate::io::input::{MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};
 /// The range of every integrator tolerance (relative and absolute; the adaptive, split and
 /// Taylor integrators use it, the exact propagator and RK4 ignore it but it is checked alike): below 1e-16 it is beneath the double's resolution, above 1e-3 no longer an accuracy.
@@ -120,3 +121,70 @@ pub(crate) fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimEr
 #[cfg(feature = "files")]
 pub use crate::io::input::read_input;
 pub use crate::io::input::InputFileError;
+
+/// The physical range of the temperature (K): above absolute zero, below where a silicon lever
+/// stays a lever.
+pub const TEMPERATURE_RANGE: (f64, f64) = (0.0, 1500.0);
+
+/// The temperatures of a measurement in a laboratory (K): a cooled to a heated stage. Below
+/// them a value is either a cryogenic AFM's or in °C (22 for 295.15 K): it warns.
+pub const TYPICAL_TEMPERATURE: (f64, f64) = (200.0, 500.0);
+
+/// The warning of a temperature `t` (K) outside [`TYPICAL_TEMPERATURE`], naming the likely slip
+/// (`thermal`'s, `calibrate`'s and `simulate`'s).
+pub fn temperature_warnings(t: f64) -> Vec<String> {
+    let (lo, hi) = TYPICAL_TEMPERATURE;
+    if (lo..=hi).contains(&t) {
+        return Vec::new();
+    }
+    vec![warning!(
+        "thermal.temperature-unit",
+        "Give the temperature in kelvin (22 °C is 295.15 K); a cryogenic or heated stage's \
+         value stands.",
+        "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
+         in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
+        t + 273.15
+    )]
+}
+
+/// Check a temperature `t` (K) against [`TEMPERATURE_RANGE`] (`thermal`'s, `calibrate`'s,
+/// `fit`'s and `simulate`'s).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `temperature`.
+pub fn check_temperature(t: f64) -> Result<(), SimError> {
+    let (lo, hi) = TEMPERATURE_RANGE;
+    if t > lo && t <= hi {
+        return Ok(());
+    }
+    Err(SimError::out_of_range(
+        "temperature",
+        crate::error::number(t),
+        "the temperature must be above absolute zero and at most 1500 K (K)",
+    ))
+}
+
+/// The thermal force of a simulated measurement at `t` (K) under `probe` with `seed`: the
+/// temperature checked ([`check_temperature`]) and k_B T in the probe's energy unit
+/// (`simulate`'s, `approach`'s and the PI scan's, [`crate::integrate::exact::noise`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `temperature` (out of range, or without a probe: the
+/// dimensionless model has no k_B T).
+pub(crate) fn thermal_force(
+    t: f64,
+    seed: u64,
+    probe: Option<&crate::probe::Probe>,
+) -> Result<crate::integrate::exact::ThermalForce, SimError> {
+    check_temperature(t)?;
+    let Some(probe) = probe else {
+        return Err(SimError::out_of_range(
+            "temperature",
+            crate::error::number(t),
+            "thermal noise needs the probe's SI units (k_B T in the model's energy unit): give \
+             the probe (--probe), or drop temperature",
+        ));
+    };
+    let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
+    Ok(crate::integrate::exact::ThermalForce::new(kt, seed))
+}

@@ -23,6 +23,7 @@
 use super::costs::{check_cost_advising, stepped_cost};
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use super::limits::Cost;
+use crate::analysis::lock_in_noise::ThermalLockIn;
 use crate::analysis::progress::Progress;
 use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
@@ -304,6 +305,21 @@ request! {
         #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
         constants(TORUS_PERIODS in crate::analysis::stepped::torus)
         pub exact: bool,
+        /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
+        /// a value in °C?); `None` (the default): no noise. With one the document gains a
+        /// `"thermal"` block: at every stable period-1 point of both sweeps the standard
+        /// deviations of the lock-in's amplitude and phase under the lever's thermal force, by
+        /// linear response about the orbit, noise within each period, switchings and the
+        /// lock-in's filter included ([`crate::analysis::lock_in_noise`]). Needs the probe's SI
+        /// units; the laws with memory (JKR, capillary, SLS, impact) and a multifrequency drive
+        /// are refused.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub temperature: Option<f64>,
+        /// The lock-in's low-pass time constant τ_L (s; with `temperature`), ≥ 0 and at most
+        /// 1 000 s; `None`: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time (the PI scan's
+        /// default). Its noise-equivalent bandwidth is about 1/(4τ_L).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub time_constant: Option<f64>,
     }
 }
 
@@ -332,7 +348,33 @@ impl ApproachRequest {
         if !average && !self.exact && uses_torus(&model.params) {
             spec.torus = Some(TorusOptions::default());
         }
+        spec.noise = self.thermal(model)?;
         Ok(spec)
+    }
+
+    /// The thermal force and lock-in of the `"thermal"` block (model units): `None` without a
+    /// temperature.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe), `drive`
+    /// (multifrequency) or `time_constant` (out of range, or without a temperature);
+    /// [`SimError::Unsupported`] for a law with memory.
+    fn thermal(&self, model: &Resolved) -> Result<Option<ThermalLockIn>, SimError> {
+        let Some(t) = self.temperature else {
+            let why = "sets the lock-in of the thermal noise, which needs a temperature: give \
+                       temperature too, or drop it";
+            let refuse =
+                |tc| SimError::out_of_range("time_constant", crate::error::number(tc), why);
+            return self.time_constant.map_or(Ok(None), |tc| Err(refuse(tc)));
+        };
+        let kt = super::limits::thermal_force(t, 0, model.probe.as_ref())?.kt;
+        crate::integrate::exact::noise::admits_model(&model.params)?;
+        let probe = model.probe.as_ref().expect("thermal_force checked it");
+        let tc = super::image_scan::lock_in_time_constant(probe, self.time_constant)?;
+        Ok(Some(ThermalLockIn {
+            kt,
+            time_constant: tc / probe.scales.time_s,
+        }))
     }
 }
 

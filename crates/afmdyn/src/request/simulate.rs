@@ -171,7 +171,7 @@ impl SimulateRequest {
     }
 
     /// The thermal force of the run: `None` without a temperature; with one, its range checked
-    /// ([`super::thermal::check_temperature`]) and k_B T in the units of `probe`.
+    /// ([`super::limits::check_temperature`]) and k_B T in the units of `probe`.
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `temperature` (out of range, or without a probe: the
@@ -181,15 +181,7 @@ impl SimulateRequest {
         let Some(t) = self.temperature else {
             return Ok(None);
         };
-        super::thermal::check_temperature(t)?;
-        let Some(probe) = probe else {
-            return Err(SimError::out_of_range(
-                "temperature",
-                crate::error::number(t),
-                "thermal noise needs the probe's SI units (k_B T in the model's energy unit): \
-                 give the probe (--probe), or drop temperature",
-            ));
-        };
+        let force = super::limits::thermal_force(t, self.seed, probe)?;
         if self.energy_balance {
             return Err(SimError::out_of_range(
                 "energy_balance",
@@ -198,12 +190,12 @@ impl SimulateRequest {
                  temperature",
             ));
         }
-        super::thermal::thermal_force(t, self.seed, probe).map(Some)
+        Ok(Some(force))
     }
 
     /// The warnings of the request: a temperature outside the laboratory's range.
     pub fn warnings(&self) -> Vec<String> {
-        (self.temperature.map(super::thermal::temperature_warnings)).unwrap_or_default()
+        (self.temperature.map(super::limits::temperature_warnings)).unwrap_or_default()
     }
 
     /// The integrator of the run of `model` from `z0` at τ = 0: [`crate::integrate::build`]'s,

@@ -3,20 +3,13 @@
 //! ranges and its declared cost ([`crate::analysis::thermal`] computes it).
 
 use super::costs::{MODEL_BYTES, OPERATION_WORK};
+use super::limits::check_temperature;
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::error::SimError;
 
 /// The default temperature (K): a laboratory's 22 °C.
 pub const DEFAULT_TEMPERATURE: f64 = 295.0;
-
-/// The physical range of the temperature (K): above absolute zero, below where a silicon lever
-/// stays a lever.
-pub const TEMPERATURE_RANGE: (f64, f64) = (0.0, 1500.0);
-
-/// The temperatures of a measurement in a laboratory (K): a cooled to a heated stage. Below
-/// them a value is either a cryogenic AFM's or in °C (22 for 295.15 K): it warns.
-pub const TYPICAL_TEMPERATURE: (f64, f64) = (200.0, 500.0);
 
 /// The default and the largest number of frequencies of the spectrum.
 pub const DEFAULT_POINTS: usize = 4096;
@@ -29,10 +22,10 @@ request! {
     pub struct ThermalRequest {
         /// The temperature T (K, > 0 and ≤ 1500; default 295 K). Outside 200–500 K it warns (a
         /// value in °C?).
-        pub temperature: Option<f64>,
+        pub temperature: f64 = DEFAULT_TEMPERATURE,
         /// The optical lever's laser spot ξ_s, a fraction of the lever's length from its base
         /// (0 < ξ_s ≤ 1; default 1, at the tip): the apparent deflection reads the slope there.
-        pub spot: Option<f64>,
+        pub spot: f64 = 1.0,
         /// The highest frequency of the spectrum (Hz, > 0); default 1.25 times the highest mode's
         /// frequency, at least 3 f₀.
         #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
@@ -40,80 +33,8 @@ request! {
         /// The number of frequencies, evenly spaced from to/points to `to` (1 to 10⁷; default
         /// 4096). A mode's peak narrower than the spacing (f_k/Q_k) is not resolved in the
         /// spectrum; each mode's share is exact whatever the spacing.
-        pub points: Option<usize>,
+        pub points: usize = DEFAULT_POINTS,
     }
-}
-
-impl ThermalRequest {
-    /// The temperature (K).
-    pub fn temperature(&self) -> f64 {
-        self.temperature.unwrap_or(DEFAULT_TEMPERATURE)
-    }
-
-    /// The laser spot (a fraction of the length).
-    pub fn spot(&self) -> f64 {
-        self.spot.unwrap_or(1.0)
-    }
-
-    /// The number of frequencies.
-    pub fn points(&self) -> usize {
-        self.points.unwrap_or(DEFAULT_POINTS)
-    }
-
-    /// The warning of a temperature outside the typical range, naming the likely slip.
-    pub fn warnings(&self) -> Vec<String> {
-        temperature_warnings(self.temperature())
-    }
-}
-
-/// The warning of a temperature `t` (K) outside [`TYPICAL_TEMPERATURE`], naming the likely slip
-/// (`thermal`'s, `calibrate`'s and `simulate`'s).
-pub fn temperature_warnings(t: f64) -> Vec<String> {
-    let (lo, hi) = TYPICAL_TEMPERATURE;
-    if (lo..=hi).contains(&t) {
-        return Vec::new();
-    }
-    vec![warning!(
-        "thermal.temperature-unit",
-        "Give the temperature in kelvin (22 °C is 295.15 K); a cryogenic or heated stage's \
-         value stands.",
-        "temperature = {t} K is outside the {lo}..{hi} K of a laboratory's stage: written \
-         in °C? ({t} °C is {} K; a cryogenic AFM's temperature is right as it is)",
-        t + 273.15
-    )]
-}
-
-/// Check a temperature `t` (K) against [`TEMPERATURE_RANGE`] (`thermal`'s, `calibrate`'s,
-/// `fit`'s and `simulate`'s).
-///
-/// # Errors
-/// [`SimError::OutOfRange`] naming `temperature`.
-pub fn check_temperature(t: f64) -> Result<(), SimError> {
-    let (lo, hi) = TEMPERATURE_RANGE;
-    if t > lo && t <= hi {
-        return Ok(());
-    }
-    Err(SimError::out_of_range(
-        "temperature",
-        crate::error::number(t),
-        "the temperature must be above absolute zero and at most 1500 K (K)",
-    ))
-}
-
-/// The thermal force of a simulated measurement at `t` (K) under `probe` with `seed`: the
-/// temperature checked ([`check_temperature`]) and k_B T in the probe's energy unit
-/// (`simulate`'s and the PI scan's, [`crate::integrate::exact::noise`]).
-///
-/// # Errors
-/// [`SimError::OutOfRange`] naming `temperature`.
-pub(crate) fn thermal_force(
-    t: f64,
-    seed: u64,
-    probe: &crate::probe::Probe,
-) -> Result<crate::integrate::exact::ThermalForce, SimError> {
-    check_temperature(t)?;
-    let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
-    Ok(crate::integrate::exact::ThermalForce::new(kt, seed))
 }
 
 /// The checks of a temperature `t` (K) and a laser spot `spot` shared by the thermal
@@ -131,20 +52,15 @@ pub(crate) fn check_thermal(model: &Resolved, t: f64, spot: f64) -> Result<(), S
         ));
     }
     check_temperature(t)?;
-    if !(spot > 0.0 && spot <= 1.0) {
-        return Err(SimError::out_of_range(
-            "spot",
-            crate::error::number(spot),
-            "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1",
-        ));
-    }
-    Ok(())
+    use std::ops::Bound::{Excluded, Included};
+    let lever = "the laser spot is a fraction of the length from the base: 0 < spot ≤ 1";
+    crate::error::within("spot", spot, (Excluded(0.0), Included(1.0)), lever)
 }
 
 impl_request! {
     ThermalRequest, "thermal", advice = "ask for fewer points";
     validate |r, model| {
-        check_thermal(model, r.temperature(), r.spot())?;
+        check_thermal(model, r.temperature, r.spot)?;
         if let Some(f) = r.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
             return Err(SimError::out_of_range(
                 "to",
@@ -154,7 +70,7 @@ impl_request! {
         }
         crate::error::within(
             "points",
-            r.points(),
+            r.points,
             1..=MAX_POINTS,
             "the number of frequencies must be 1..=10000000",
         )
@@ -163,7 +79,7 @@ impl_request! {
     // the layouts and the document's JSON values (256 bytes a frequency).
     cost |r, model| {
         let n = model.params.modes as f64;
-        let points = r.points() as f64;
+        let points = r.points as f64;
         Ok(Cost {
             bytes: MODEL_BYTES + points * 256.0,
             work: points * OPERATION_WORK * (n * n * n + 4.0 * n * n),

@@ -116,8 +116,8 @@ impl Analysis for CalibrateRequest {
             f_psd.1.iter_mut().for_each(|v| *v *= s * s);
         }
         let units = super::model_units(&probe.scales);
-        let t = self.temperature();
-        let spectrum = thermal_spectrum(&model.params, units, t, self.spot(), &[], progress)?;
+        let t = self.temperature;
+        let spectrum = thermal_spectrum(&model.params, units, t, self.spot, &[], progress)?;
         let modes = &spectrum.modes[..self.peaks.unwrap_or(spectrum.modes.len())];
         let medium = probe.medium.as_ref().map_or(Medium::AIR, |m| Medium {
             density: m.density,
@@ -131,7 +131,7 @@ impl Analysis for CalibrateRequest {
             }
         }
         c.invols = measured;
-        c.warnings = self.warnings();
+        c.warnings = crate::request::limits::temperature_warnings(self.temperature);
         if probe.plan.is_none() {
             c.warnings.push(warning!(
                 "calibrate.no-plan",

@@ -310,7 +310,7 @@ impl ScanStudy {
         };
         if let Some(t) = self.recipe.scan.temperature {
             img.warnings
-                .extend(crate::request::thermal::temperature_warnings(t));
+                .extend(crate::request::limits::temperature_warnings(t));
             for m in &self.job.spec.materials {
                 let (_, scheme) = crate::integrate::exact::noise::thermal_method(&m.contact_law);
                 for w in scheme {

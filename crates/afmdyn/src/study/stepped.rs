@@ -183,6 +183,13 @@ impl Analysis for ApproachRequest {
                 ws.extend(gaps);
             }
         }
+        if let (Some(t), Some(n)) = (self.temperature, self.spec(model)?.noise) {
+            doc["thermal"] = report::thermal_noise(&model.params, t, n.time_constant, &u);
+            let ws = crate::request::limits::temperature_warnings(t);
+            if let Some(w) = doc["warnings"].as_array_mut() {
+                w.extend(ws.into_iter().map(Value::from));
+            }
+        }
         // the default range ends at the soft sample's force bound (default_range): say so when
         // the amplitude has not come down to half the free one by then
         if self.curve.to.is_none() && self.curve.from.is_none() {

@@ -17,7 +17,7 @@ impl ThermalRequest {
         let top = modes.iter().copied().fold(0.0, f64::max);
         let first = modes.first().copied().unwrap_or(top);
         let to = self.to.unwrap_or((1.25 * top).max(3.0 * first));
-        let n = self.points();
+        let n = self.points;
         (1..=n).map(|i| to * i as f64 / n as f64).collect()
     }
 }
@@ -30,7 +30,7 @@ impl Analysis for ThermalRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ThermalSpectrum, SimError> {
         let probe = model.probe.as_ref().expect("validated: a probe");
         let units = super::model_units(&probe.scales);
-        let (t, spot) = (self.temperature(), self.spot());
+        let (t, spot) = (self.temperature, self.spot);
         // the modes first (no frequency), then the spectrum at the frequencies they set
         let modes = thermal_spectrum(&model.params, units, t, spot, &[], progress)?;
         let f: Vec<f64> = modes.modes.iter().map(|m| m.frequency).collect();
@@ -74,7 +74,7 @@ impl super::named::Datasets for ThermalRequest {
 /// (`frequency` Hz, `deflection` and `apparent_deflection` m²/Hz), `units`, `method` and
 /// `warnings`.
 pub(crate) fn document(r: &ThermalRequest, s: &ThermalSpectrum) -> Value {
-    let mut warnings = r.warnings();
+    let mut warnings = crate::request::limits::temperature_warnings(r.temperature);
     if !s.reads_slope {
         warnings.push(warning!(
             "thermal.no-beam",

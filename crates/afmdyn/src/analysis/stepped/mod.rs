@@ -34,8 +34,10 @@
 //! instead ([`torus`], [`SteppedSpec::torus`]; the exact orbit where a circle is not smooth),
 //! and any multifrequency drive by the time average ([`average`]).
 
+use crate::analysis::am_loop::LOCK_IN_SAMPLES;
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
+use crate::analysis::lock_in_noise::{lock_in_noise, LockInNoise, ThermalLockIn};
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
 use crate::analysis::progress::Progress;
 pub use crate::analysis::settle::Found;
@@ -185,6 +187,9 @@ pub struct SteppedSpec {
     pub torus: Option<TorusOptions>,
     /// How long [`settle`] waits before a motion is settled by its time average.
     pub settle_wait: SettleWait,
+    /// The lock-in's thermal noise at every stable period-1 point of the two sweeps
+    /// ([`crate::analysis::lock_in_noise`]); `None`: none.
+    pub noise: Option<ThermalLockIn>,
 }
 
 impl SteppedSpec {
@@ -219,6 +224,7 @@ impl SteppedSpec {
             average: None,
             torus: None,
             settle_wait: SettleWait::default(),
+            noise: None,
         }
     }
 }
@@ -367,6 +373,10 @@ pub struct SteppedCurve {
     /// The time average's options when the points were measured by it ([`average`]; each
     /// point's estimate is its [`CurvePoint::average`]).
     pub average: Option<AverageOptions>,
+    /// The lock-in's thermal noise per point of `first` and `second`
+    /// ([`SteppedSpec::noise`]); [`LockInNoise::NONE`] where a point is not a stable period-1
+    /// orbit.
+    pub noise: Option<[Vec<LockInNoise>; 2]>,
 }
 
 impl SteppedCurve {
@@ -617,8 +627,6 @@ pub(crate) fn finish_curve(
     };
     Ok(SteppedCurve {
         param: spec.param,
-        first,
-        second,
         branches,
         jumps,
         folds,
@@ -626,7 +634,44 @@ pub(crate) fn finish_curve(
         warnings,
         traces,
         average: spec.average,
+        noise: curve_noise(spec, [&first, &second], progress)?,
+        first,
+        second,
     })
+}
+
+/// The lock-in's thermal noise of [`SteppedSpec::noise`] at each point of the two sweeps:
+/// [`LockInNoise::NONE`] at a point that is not a stable period-1 orbit (time-averaged,
+/// on an invariant circle, unstable or of a longer period).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `progress` is cancelled; as [`lock_in_noise`].
+fn curve_noise(
+    spec: &SteppedSpec,
+    sweeps: [&[CurvePoint]; 2],
+    progress: &Progress,
+) -> Result<Option<[Vec<LockInNoise>; 2]>, SimError> {
+    let Some(n) = spec.noise else {
+        return Ok(None);
+    };
+    let sweep = |points: &[CurvePoint]| -> Result<Vec<LockInNoise>, SimError> {
+        points
+            .iter()
+            .map(|p| {
+                progress.check()?;
+                let orbit = p.period == Some(1)
+                    && p.stable
+                    && p.average.is_none()
+                    && (p.circle.is_none() || p.fallback.is_some());
+                if !orbit {
+                    return Ok(LockInNoise::NONE);
+                }
+                let model = CantileverModel::new(&spec.base.with(spec.param, p.value))?;
+                lock_in_noise(&model, &p.state, n.kt, n.time_constant, LOCK_IN_SAMPLES)
+            })
+            .collect()
+    };
+    Ok(Some([sweep(sweeps[0])?, sweep(sweeps[1])?]))
 }
 
 /// The warnings on the two sweeps' points (averaged or unsettled ones, a free decay) and on

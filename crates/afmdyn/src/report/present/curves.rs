@@ -7,6 +7,7 @@
 use super::curve_figures::{panels, traces_figure, Labels, Shown};
 use super::Files;
 use crate::analysis::approach::rest_distance;
+use crate::analysis::lock_in_noise::LockInNoise;
 use crate::analysis::stepped::{SteppedCurve, Sweep};
 use crate::analysis::traces::Traces;
 use crate::layout::{Layout, Variable};
@@ -99,6 +100,9 @@ fn present(s: &Shown<'_>, params: &Params, document: &Value, o: &CurveOptions) -
     if let Some(sp) = document.get("setpoint") {
         setpoint(&mut p, sp, s.l, s.u);
     }
+    if let Some(t) = document.get("thermal") {
+        thermal(&mut p, t, s);
+    }
     if o.files == Files::None {
         return p;
     }
@@ -179,6 +183,44 @@ fn summary(p: &mut Presentation, s: &Shown<'_>) {
                 .map_or(String::new(), |fv| format!(" (fold at {})", l.show(x(fv))))
         ));
     }
+}
+
+/// The line of the `"thermal"` block (an approach with a temperature): the lock-in's time
+/// constant and bandwidth, and the range of σ_A and σ_φ over the stable period-1 points.
+fn thermal(p: &mut Presentation, t: &Value, s: &Shown<'_>) {
+    let Some(noise) = &s.c.noise else {
+        return;
+    };
+    let range = |f: &dyn Fn(&LockInNoise) -> f64| {
+        let v = noise.iter().flatten().map(f).filter(|v| v.is_finite());
+        v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        })
+    };
+    let (a, b) = range(&|n| n.amplitude * s.u.length);
+    let (c, d) = range(&|n| n.phase.to_degrees());
+    if a > b {
+        return;
+    }
+    let num = |k: &str| t[k].as_f64().unwrap_or(f64::NAN);
+    let text = s.l.text;
+    let (tc, bw) = match s.l.x_unit {
+        Some(_) => (
+            text.value(num("time_constant"), "s"),
+            text.value(num("bandwidth"), "Hz"),
+        ),
+        None => (
+            format!("{:.6e}", num("time_constant")),
+            format!("{:.6e}", num("bandwidth")),
+        ),
+    };
+    p.line(format!(
+        "  thermal noise at {} K (lock-in τ_L = {tc}, bandwidth {bw}): σ_A {} to {}, σ_φ \
+         {c:.4}° to {d:.4}°",
+        num("temperature"),
+        s.l.show(a),
+        s.l.show(b)
+    ));
 }
 
 /// Below this fraction of the model's force and energy units (F̃ and F̃·g₀: kA₀ and kA₀² for
