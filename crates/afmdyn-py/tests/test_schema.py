@@ -126,6 +126,8 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("approach", ["--points", 5, "--no-branches", "--files", "none", "--probe", P1]),
     ("approach", ["--points", 9, "--files", "none", "--setpoint", 0.8, "--probe", P1]),
     ("approach", ["--points", 3, "--no-branches", "--files", "none", "--traces", 8, "--probe", P1]),
+    ("approach", ["--points", 9, "--files", "none", "--setpoint", 0.8, "--probe", P1,
+                  "--temperature", 295]),
     ("resonance", ["--points", 5, "--no-branches", "--files", "none"]),
     ("resonance", ["--points", 5, "--no-branches", "--files", "none", "--probe", P1]),
     ("chart", ["--x-steps", 2, "--y-steps", 1, "--starts", 1, "--lyapunov-periods", 20, *SHORT]),

@@ -352,8 +352,9 @@ fn traces_are_the_steady_cycles_of_the_curve() {
 /// slow amplitude's first-order response behind the lock-in's first-order filter; equipartition
 /// k_BT/k at τ_L → 0): within 1 % (its 1/Q corrections), at the default τ_L = τ_c/4 and at a
 /// given τ_L = 1 ms. In the repulsive regime the sample stiffens the amplitude, so σ_A falls
-/// below the free lever's. Refused: without a probe, a time constant without a temperature,
-/// a law with memory (JKR).
+/// below the free lever's. Points within 5 thermal standard deviations of the surface are
+/// said to be beyond the linear response. Refused: without a probe, a time constant without a
+/// temperature, a law with memory (JKR).
 #[test]
 fn a_temperature_gives_the_lock_ins_thermal_noise() {
     use afmdyn::analysis::progress::Progress;
@@ -410,6 +411,29 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
         // free: the phase quadrature carries the same noise, σ_φ = σ/A
         assert!((phase.to_radians() * a / free - 1.0).abs() < 0.01);
     }
+    // 40 points put two of them at the attractive–repulsive transition, within 5σ of the
+    // surface: their noise is said to be beyond the linear response
+    let fine = ApproachRequest {
+        curve: CurveRequest {
+            points: Some(40),
+            branches: false,
+            ..CurveRequest::default()
+        },
+        temperature: Some(295.0),
+        ..ApproachRequest::default()
+    };
+    let doc = run(&fine, &model, &Progress::new()).unwrap().json;
+    let offset = probe.params.contact_law.distance_offset() * probe.scales.length_m;
+    let sigma = (kt / k).sqrt();
+    let near = (doc["approach"]["min_distance"].as_array().unwrap().iter())
+        .chain(doc["retract"]["min_distance"].as_array().unwrap())
+        .filter(|d| (d.as_f64().unwrap() - offset).abs() < 5.0 * sigma)
+        .count();
+    let said = doc["warnings"].to_string();
+    assert!(
+        near > 0 && said.contains(&format!("{near} point(s) pass within 5 thermal")),
+        "{near}: {said}"
+    );
     let refused = |model: &Resolved, request: ApproachRequest| {
         run(&request, model, &Progress::new()).unwrap_err()
     };

@@ -625,8 +625,11 @@ pub(crate) fn finish_curve(
             )?)
         }
     };
+    let noise = curve_noise(spec, [&first, &second], progress, &mut warnings)?;
     Ok(SteppedCurve {
         param: spec.param,
+        first,
+        second,
         branches,
         jumps,
         folds,
@@ -634,15 +637,22 @@ pub(crate) fn finish_curve(
         warnings,
         traces,
         average: spec.average,
-        noise: curve_noise(spec, [&first, &second], progress)?,
-        first,
-        second,
+        noise,
     })
 }
+
+/// Within how many of the free lever's thermal standard deviations √(k_BT c_s) of the surface
+/// (c_s its static compliance at the tip) an orbit's lowest point may pass, above it or inside
+/// it, before the noise changes its contacts from period to period: the lock-in's noise of
+/// such a point is beyond the linear response (`curve_noise` warns).
+const NOISE_GRAZING: f64 = 5.0;
 
 /// The lock-in's thermal noise of [`SteppedSpec::noise`] at each point of the two sweeps:
 /// [`LockInNoise::NONE`] at a point that is not a stable period-1 orbit (time-averaged,
 /// on an invariant circle, unstable or of a longer period).
+///
+/// Warns in `warnings` of the points whose lowest point passes within [`NOISE_GRAZING`]
+/// thermal standard deviations of the surface.
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `progress` is cancelled; as [`lock_in_noise`].
@@ -650,10 +660,27 @@ fn curve_noise(
     spec: &SteppedSpec,
     sweeps: [&[CurvePoint]; 2],
     progress: &Progress,
+    warnings: &mut Vec<String>,
 ) -> Result<Option<[Vec<LockInNoise>; 2]>, SimError> {
     let Some(n) = spec.noise else {
         return Ok(None);
     };
+    let model = CantileverModel::new(&spec.base)?;
+    let sigma = (n.kt * crate::analysis::peakforce::static_compliance(&model)).sqrt();
+    let offset = spec.base.contact_law.distance_offset();
+    let near = (sweeps.iter().flat_map(|s| s.iter()))
+        .filter(|p| (p.observables.min_distance - offset).abs() < NOISE_GRAZING * sigma)
+        .count();
+    if near > 0 {
+        warnings.push(warning!(
+            "thermal.noise-grazing",
+            "Read their amplitude_noise and phase_noise_deg as estimates only; a time-domain \
+             run measures the noise there (image --feedback pi --temperature).",
+            "{near} point(s) pass within {NOISE_GRAZING} thermal standard deviations √(k_BT/k) of \
+             the surface, above or inside it, where the noise adds or removes contacts from period \
+             to period: their lock-in noise is beyond the linear response"
+        ));
+    }
     let sweep = |points: &[CurvePoint]| -> Result<Vec<LockInNoise>, SimError> {
         points
             .iter()
