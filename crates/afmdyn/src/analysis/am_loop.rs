@@ -73,6 +73,16 @@ impl FeedbackGains {
     }
 }
 
+/// The low-pass's weight per period β = 1 − e^{−T/τ_L} of a lock-in of time constant
+/// `time_constant` (τ_L ≥ 0) updated once per `period` (T): 1 for τ_L = 0 (module docs).
+pub(crate) fn lock_in_beta(time_constant: f64, period: f64) -> f64 {
+    if time_constant > 0.0 {
+        -(-period / time_constant).exp_m1()
+    } else {
+        1.0
+    }
+}
+
 /// The lock-in amplifier (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct LockIn {
@@ -87,13 +97,8 @@ impl LockIn {
     /// A lock-in of time constant `time_constant` (τ_L ≥ 0) updated once per `period`, its
     /// output preloaded with (`amplitude`, `phase`).
     pub(crate) fn new(time_constant: f64, period: f64, amplitude: f64, phase: f64) -> Self {
-        let beta = if time_constant > 0.0 {
-            -(-period / time_constant).exp_m1()
-        } else {
-            1.0
-        };
         LockIn {
-            beta,
+            beta: lock_in_beta(time_constant, period),
             x: amplitude * phase.cos(),
             y: amplitude * phase.sin(),
         }

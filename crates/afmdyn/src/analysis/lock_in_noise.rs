@@ -181,11 +181,7 @@ fn period_chain(
         }
     }
     // the period's end: X̄ ← (1 − β) X̄ + β X, then the sums start again
-    let beta = if time_constant > 0.0 {
-        -(-period / time_constant).exp_m1()
-    } else {
-        1.0
-    };
+    let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period);
     m.fill_with_identity();
     for (i, from) in [(ixb, ix), (iyb, iy)] {
         m[(i, i)] = 1.0 - beta;

@@ -508,11 +508,7 @@ pub(crate) fn thermal_noise(
     u: &CurveUnits,
 ) -> Value {
     let period = params.period();
-    let beta = if time_constant > 0.0 {
-        -(-period / time_constant).exp_m1()
-    } else {
-        1.0
-    };
+    let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period);
     json!({
         "temperature": temperature,
         "time_constant": time_constant * u.time,

@@ -303,6 +303,15 @@ fn is_zero(x: &f64) -> bool {
 }
 
 impl CurvePoint {
+    /// A stable period-1 orbit, whose lock-in noise [`SteppedSpec::noise`] asks for: not
+    /// time-averaged, not on an invariant circle, not of a longer period.
+    fn noise_orbit(&self) -> bool {
+        self.period == Some(1)
+            && self.stable
+            && self.average.is_none()
+            && (self.circle.is_none() || self.fallback.is_some())
+    }
+
     /// A time-averaged point whose windows still differed at its transient cap ([`average`]):
     /// not converged (the curve's warnings count them).
     pub(crate) fn unsettled(&self) -> bool {
@@ -669,6 +678,7 @@ fn curve_noise(
     let sigma = (n.kt * crate::analysis::peakforce::static_compliance(&model)).sqrt();
     let offset = spec.base.contact_law.distance_offset();
     let near = (sweeps.iter().flat_map(|s| s.iter()))
+        .filter(|p| p.noise_orbit())
         .filter(|p| (p.observables.min_distance - offset).abs() < NOISE_GRAZING * sigma)
         .count();
     if near > 0 {
@@ -686,11 +696,7 @@ fn curve_noise(
             .iter()
             .map(|p| {
                 progress.check()?;
-                let orbit = p.period == Some(1)
-                    && p.stable
-                    && p.average.is_none()
-                    && (p.circle.is_none() || p.fallback.is_some());
-                if !orbit {
+                if !p.noise_orbit() {
                     return Ok(LockInNoise::NONE);
                 }
                 let model = CantileverModel::new(&spec.base.with(spec.param, p.value))?;
