@@ -353,8 +353,9 @@ fn traces_are_the_steady_cycles_of_the_curve() {
 /// k_BT/k at τ_L → 0): within 1 % (its 1/Q corrections), at the default τ_L = τ_c/4 and at a
 /// given τ_L = 1 ms. In the repulsive regime the sample stiffens the amplitude, so σ_A falls
 /// below the free lever's. Points within 5 thermal standard deviations of the surface are
-/// said to be beyond the linear response. Refused: without a probe, a time constant without a
-/// temperature, a law with memory (JKR).
+/// said to be beyond the linear response. At a setpoint the operating points carry the noise of
+/// their orbits. Refused: without a probe, a time constant without a temperature, a law with
+/// memory (JKR).
 #[test]
 fn a_temperature_gives_the_lock_ins_thermal_noise() {
     use afmdyn::analysis::progress::Progress;
@@ -434,6 +435,26 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
         near > 0 && said.contains(&format!("{near} point(s) pass within 5 thermal")),
         "{near}: {said}"
     );
+    // at a setpoint equal to a sweep point's A/A0 the operating point is that orbit: its
+    // lock-in noise in the setpoint block is the sweep's there
+    let sweep = &doc["approach"];
+    let i = 30;
+    let ratio = sweep["amplitude_ratio"][i].as_f64().unwrap();
+    let at = ApproachRequest {
+        setpoint: Some(ratio),
+        ..fine.clone()
+    };
+    let doc = run(&at, &model, &Progress::new()).unwrap().json;
+    let z_c = sweep["z_c"][i].as_f64().unwrap();
+    let op = (doc["setpoint"]["points"].as_array().unwrap().iter())
+        .find(|p| {
+            p["source"] == "approach" && (p["z_c"].as_f64().unwrap() / z_c - 1.0).abs() < 1e-6
+        })
+        .expect("the operating point at the sweep's point");
+    for key in ["amplitude_noise", "phase_noise_deg"] {
+        let (o, s) = (op[key].as_f64().unwrap(), sweep[key][i].as_f64().unwrap());
+        assert!((o / s - 1.0).abs() < 1e-4, "{key}: {o} vs {s}");
+    }
     let refused = |model: &Resolved, request: ApproachRequest| {
         run(&request, model, &Progress::new()).unwrap_err()
     };

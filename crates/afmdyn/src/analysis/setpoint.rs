@@ -16,6 +16,8 @@
 //! and one on the repulsive branch: which one the instrument holds depends on its history
 //! (García & San Paulo, Phys. Rev. B 61, R13381 (2000)).
 
+use super::am_loop::LOCK_IN_SAMPLES;
+use super::lock_in_noise::{lock_in_noise, LockInNoise};
 use super::observables::{observe, ObservableOptions, Observables};
 use super::shooting::shoot;
 use super::stepped::{SteppedCurve, SteppedSpec, Sweep};
@@ -105,6 +107,9 @@ pub struct OperatingPoint {
     pub crossing: Crossing,
     /// The observables of the orbit there (`None`: interpolate between the crossing's points).
     pub exact: Option<Observables>,
+    /// The lock-in's thermal noise of the period-1 orbit there, with [`SteppedSpec::noise`]
+    /// ([`crate::analysis::lock_in_noise`]); `None` otherwise.
+    pub noise: Option<LockInNoise>,
 }
 
 /// Iterations of the regula falsi on one crossing.
@@ -138,7 +143,7 @@ pub(crate) fn operating_points(
             (Some((na, za)), Some((nb, zb))) if na == nb => {
                 let lo = (a.value, za.clone(), a.ratio - ratio);
                 let hi = (b.value, zb.clone(), b.ratio - ratio);
-                let Some((value, o)) = refine(spec, na, ratio, lo, hi)? else {
+                let Some((value, o, z)) = refine(spec, na, ratio, lo, hi)? else {
                     dropped.push(k);
                     continue;
                 };
@@ -154,15 +159,27 @@ pub(crate) fn operating_points(
                         })
                 });
                 if !seen {
+                    let noise = match spec.noise.filter(|_| na == 1) {
+                        Some(n) => Some(lock_in_noise(
+                            &CantileverModel::new(&spec.base.with(spec.param, value))?,
+                            &z,
+                            n.kt,
+                            n.time_constant,
+                            LOCK_IN_SAMPLES,
+                        )?),
+                        None => None,
+                    };
                     out.push(OperatingPoint {
                         crossing: Crossing { value, ..k },
                         exact: Some(o),
+                        noise,
                     });
                 }
             }
             _ => out.push(OperatingPoint {
                 crossing: k,
                 exact: None,
+                noise: None,
             }),
         }
     }
@@ -210,21 +227,21 @@ fn ends<'a>(curve: &'a SteppedCurve, k: &Crossing) -> (End<'a>, End<'a>) {
 /// residuals of opposite signs, or one zero): regula falsi with the Illinois modification on
 /// the swept value (Dowell & Jarratt, BIT 11, 168 (1971)), each trial orbit shot from the state
 /// interpolated between the bracket's and accepted only when it stays within the curve's jump
-/// tolerance of that state (a continuous piece of curve); `None` where it does not (the curve
-/// jumps inside the bracket) or shooting fails.
+/// tolerance of that state (a continuous piece of curve): (value, observables, state at τ = 0);
+/// `None` where it does not (the curve jumps inside the bracket) or shooting fails.
 fn refine(
     spec: &SteppedSpec,
     n: usize,
     ratio: f64,
     mut lo: Bracketed,
     mut hi: Bracketed,
-) -> Result<Option<(f64, Observables)>, SimError> {
+) -> Result<Option<(f64, Observables, DVector<f64>)>, SimError> {
     let opts = ObservableOptions {
         periods: n,
         ..spec.observables
     };
     let mut side = 0i8;
-    let mut best: Option<(f64, Observables, f64)> = None;
+    let mut best: Option<(f64, Observables, f64, DVector<f64>)> = None;
     for _ in 0..REFINE_ITERATIONS {
         let (g_lo, g_hi) = (lo.2, hi.2);
         let t = if g_hi == g_lo {
@@ -258,7 +275,7 @@ fn refine(
         let obs = observe(integ.as_mut(), &opts)?;
         let g = obs.amplitude / obs.closed_form.free_amplitude - ratio;
         if best.as_ref().is_none_or(|b| g.abs() < b.2.abs()) {
-            best = Some((value, obs, g));
+            best = Some((value, obs, g, o.state.clone()));
         }
         if g.abs() <= REFINE_TOL {
             break;
@@ -278,7 +295,7 @@ fn refine(
             side = 1;
         }
     }
-    Ok(best.map(|(v, o, _)| (v, o)))
+    Ok(best.map(|(v, o, _, z)| (v, o, z)))
 }
 
 #[cfg(test)]

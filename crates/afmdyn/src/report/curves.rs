@@ -581,6 +581,12 @@ pub(crate) fn setpoint(
             for (c, v) in CURVE_COLUMNS.iter().zip(row) {
                 m.insert(c.name.into(), json!(v));
             }
+            // with a temperature: the lock-in's noise of the operating orbit
+            if let Some(n) = op.noise {
+                let [a, p] = NOISE_COLUMNS.map(|c| c.name);
+                m.insert(a.into(), json!(n.amplitude * u.length));
+                m.insert(p.into(), json!(n.phase.to_degrees()));
+            }
             // a multifrequency drive: each component's amplitude, phase, virial and E_dis there
             let names = component_columns(comps.len() / 4);
             for ((name, _, _), v) in names.into_iter().zip(comps) {

@@ -289,6 +289,14 @@ fn setpoint(out: &mut Presentation, sp: &Value, l: &Labels, u: &CurveUnits) {
             num(p, "phase_deg"),
             length(num(p, "indentation")),
         ));
+        // with a temperature: the lock-in's noise there
+        if let Some(a) = p.get("amplitude_noise").and_then(Value::as_f64) {
+            out.line(format!(
+                "    thermal noise: σ_A = {}, σ_φ = {:.4}°",
+                length(a),
+                num(p, "phase_noise_deg")
+            ));
+        }
         // a multifrequency drive: each component's amplitude and phase there
         for i in 1.. {
             let Some(amp) = p.get(format!("amplitude_{i}")).and_then(Value::as_f64) else {
