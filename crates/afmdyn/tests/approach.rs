@@ -374,17 +374,19 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
     );
     let tau_c = 2.0 * q / (std::f64::consts::TAU * f0);
     let kt = 1.380_649e-23 * 295.0;
+    // an approach of `points` points without branches at 295 K, the lock-in's τ_L `tc`
+    let hot = |points: usize, tc: Option<f64>| ApproachRequest {
+        curve: CurveRequest {
+            points: Some(points),
+            branches: false,
+            ..CurveRequest::default()
+        },
+        temperature: Some(295.0),
+        time_constant: tc,
+        ..ApproachRequest::default()
+    };
     for (tc, tl) in [(None, tau_c / 4.0), (Some(1e-3), 1e-3)] {
-        let request = ApproachRequest {
-            curve: CurveRequest {
-                points: Some(12),
-                branches: false,
-                ..CurveRequest::default()
-            },
-            temperature: Some(295.0),
-            time_constant: tc,
-            ..ApproachRequest::default()
-        };
+        let request = hot(12, tc);
         let doc = run(&request, &model, &Progress::new()).unwrap().json;
         let t = &doc["thermal"];
         assert!((t["time_constant"].as_f64().unwrap() / tl - 1.0).abs() < 1e-9);
@@ -414,15 +416,7 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
     }
     // 40 points put two of them at the attractive–repulsive transition, within 5σ of the
     // surface: their noise is said to be beyond the linear response
-    let fine = ApproachRequest {
-        curve: CurveRequest {
-            points: Some(40),
-            branches: false,
-            ..CurveRequest::default()
-        },
-        temperature: Some(295.0),
-        ..ApproachRequest::default()
-    };
+    let fine = hot(40, None);
     let doc = run(&fine, &model, &Progress::new()).unwrap().json;
     let offset = probe.params.contact_law.distance_offset() * probe.scales.length_m;
     let sigma = (kt / k).sqrt();
@@ -458,11 +452,7 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
     let refused = |model: &Resolved, request: ApproachRequest| {
         run(&request, model, &Progress::new()).unwrap_err()
     };
-    let hot = ApproachRequest {
-        temperature: Some(295.0),
-        ..ApproachRequest::default()
-    };
-    let e = refused(&Resolved::plain(probe.params), hot.clone());
+    let e = refused(&Resolved::plain(probe.params), hot(2, None));
     assert!(
         matches!(&e, SimError::OutOfRange { name, .. } if *name == "temperature"),
         "{e}"
@@ -487,7 +477,7 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
             params: jkr.params,
             probe: Some(jkr),
         },
-        hot,
+        hot(2, None),
     );
     assert!(matches!(e, SimError::Unsupported { .. }), "{e}");
 }

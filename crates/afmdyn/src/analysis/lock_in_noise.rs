@@ -13,9 +13,10 @@
 //! chain is then a linear system in discrete time: over one period y ↦ F y + ξ, ξ Gaussian with
 //! covariance W. F is the product of the flow's Jacobians over M·[`SUBSTEPS`] equal parts of the
 //! period ([`crate::maps::flow`]: the step Jacobians and the saltation matrices) and of the
-//! lock-in's linear maps; W accumulates the noise injected over each part, Φ(τ_b,τ_a) by the
-//! trapezoid rule h/2 (Φ D Φᵀ + D) (relative error (ωh)²/12 ≈ 10⁻⁵ for the first mode at 512
-//! parts per period), carried through every later map. The stationary covariance Y = F Y Fᵀ + W
+//! lock-in's linear maps; W accumulates the noise injected over each part (τ_a, τ_b) of length
+//! h, ∫ Φ(τ_b,s) D Φ(τ_b,s)ᵀ ds by the trapezoid rule h/2 (Φ D_a Φᵀ + D_b), Φ = Φ(τ_b,τ_a)
+//! (relative error (ωh)²/12 ≈ 10⁻⁵ for the first mode at 512 parts per period), carried
+//! through every later map. The stationary covariance Y = F Y Fᵀ + W
 //! (the discrete Lyapunov equation) is summed by doubling, Y = Σ_k F^k W F^kᵀ (Smith 1968),
 //! and σ_A² = gᵀYg, σ_φ² = hᵀYh with g = (X̄, Ȳ)/A and h = (−Ȳ, X̄)/A² on (δX̄, δȲ): the
 //! gradients of A = |(X̄, Ȳ)| and φ = arg(X̄ + iȲ) at the orbit's first harmonic.

@@ -152,9 +152,11 @@ pub(crate) fn recorded_sample_bytes(params: &Params) -> f64 {
 pub(crate) const TRACE_GROWTH: f64 = 3.5;
 
 /// The work of the lock-in's thermal noise at one point of a stepped curve, in drive periods of
-/// the model per mode (`stepped_cost`): its period of variational flows and the products of its
-/// chain, about eight periods' worth.
-const NOISE_PERIODS: f64 = 8.0;
+/// the model per mode (`stepped_cost`): its period of variational flows in 512 parts and the
+/// products of its chain. Measured 2 ms a point against 0.125 ms a simulated period
+/// (`approach --points 60 --no-branches` with and without `--temperature`, `simulate --periods
+/// 2000`, examples/probe-beam-dmt.toml): 16 periods.
+const NOISE_PERIODS: f64 = 16.0;
 
 /// The cost of a stepped curve (`approach`, `resonance`): every point's steady state (one way,
 /// and back with branches: each value twice), up to `max_branch_points` Newton solves of the

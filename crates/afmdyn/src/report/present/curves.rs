@@ -202,18 +202,13 @@ fn thermal(p: &mut Presentation, t: &Value, s: &Shown<'_>) {
     if a > b {
         return;
     }
+    // a temperature needs the probe: the block is in SI
     let num = |k: &str| t[k].as_f64().unwrap_or(f64::NAN);
     let text = s.l.text;
-    let (tc, bw) = match s.l.x_unit {
-        Some(_) => (
-            text.value(num("time_constant"), "s"),
-            text.value(num("bandwidth"), "Hz"),
-        ),
-        None => (
-            format!("{:.6e}", num("time_constant")),
-            format!("{:.6e}", num("bandwidth")),
-        ),
-    };
+    let (tc, bw) = (
+        text.value(num("time_constant"), "s"),
+        text.value(num("bandwidth"), "Hz"),
+    );
     p.line(format!(
         "  thermal noise at {} K (lock-in τ_L = {tc}, bandwidth {bw}): σ_A {} to {}, σ_φ \
          {c:.4}° to {d:.4}°",
