@@ -610,7 +610,7 @@ impl CantileverModel {
     }
     /// (sin Ωτ, cos Ωτ) as V_T needs them (eq. 8): without the sine and cosine where the base
     /// does not move (the point mass, whose V_T = W + α5), as they are multiplied by 0 there.
-    fn base_trig(&self, tau: f64) -> (f64, f64) {
+    pub(crate) fn base_trig(&self, tau: f64) -> (f64, f64) {
         if self.params.base_amplitude() == 0.0 {
             (0.0, 0.0)
         } else {

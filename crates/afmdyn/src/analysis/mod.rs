@@ -26,6 +26,7 @@ pub mod global_continuation;
 pub mod lock_in_noise;
 pub mod lyapunov;
 pub mod observables;
+pub(crate) mod orbit_noise;
 pub mod peakforce;
 pub mod period;
 pub mod progress;

@@ -12,7 +12,7 @@ use crate::analysis::shooting::{shoot, ShootingOptions};
 use crate::analysis::thermal::{thermal_spectrum, ModelUnits, BOLTZMANN};
 use crate::integrate::exact::noise::holding_samples;
 use crate::integrate::exact::{ThermalExact, ThermalForce};
-use crate::integrate::Integrator;
+use crate::integrate::{build, Integrator};
 use crate::maps::StroboscopicMap;
 use crate::probe::Probe;
 use std::f64::consts::TAU;

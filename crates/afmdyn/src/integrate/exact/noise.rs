@@ -242,6 +242,19 @@ pub(crate) fn linear_part(model: &CantileverModel) -> Result<CantileverModel, Si
     Ok(CantileverModel::new(&p)?)
 }
 
+/// The contact's rate ω_c = (|∂F_c/∂δ|/m_eff)^{1/2} + |∂F_c/∂δ̇|/m_eff of the tip force `e`
+/// (module docs): the spring's natural frequency and the dashpot's decay rate at the tip.
+fn rate_of(e: &crate::contact::ForceEval, m_eff: f64) -> f64 {
+    (e.d_delta.abs() / m_eff).sqrt() + e.d_rate.abs() / m_eff
+}
+
+/// [`rate_of`] the tip force of `model` at (τ, z) (0 where none acts).
+pub(crate) fn contact_rate(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> f64 {
+    let r = model.region_at(tau, z);
+    let e = model.tip_force_eval(r, model.base_trig(tau), z.as_slice());
+    rate_of(&e, model.effective_mass())
+}
+
 /// How far apart, in ulps of τ, a target time and the lattice point it names may be rounded
 /// (a sample time start + k·T/S against the lattice's p·T + k·h).
 const ROUNDING_ULPS: f64 = 8.0;
@@ -816,7 +829,7 @@ impl ThermalExact {
         let wdd = tip.dot(&rate.rows(n, n)) + e.force / m_eff;
         let [_, vd, vdd] = m.v_t_at(sc, [w[0], w[1], wdd]);
         let f1 = -(e.d_delta * vd + e.d_rate * vdd);
-        let omega_c = (e.d_delta.abs() / m_eff).sqrt() + e.d_rate.abs() / m_eff;
+        let omega_c = rate_of(&e, m_eff);
         let need = (self.det.grid.h * omega_c / STIFF_ETA).log2().ceil();
         let rung = if need.is_nan() || need <= 0.0 {
             0

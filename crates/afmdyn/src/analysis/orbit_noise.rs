@@ -1,0 +1,221 @@
+//! The linear response of a periodic orbit to the thermal force: the chain of the deviations
+//! from the orbit over its period, their stationary covariance at the period's start and their
+//! covariance at any time of it. The lock-in's noise ([`super::lock_in_noise`]) and a PeakForce
+//! tap's ([`super::peakforce::tap_noise`]) are read from it.
+//!
+//! **The chain.** Small deviations δz from the period-n orbit z*(τ) obey the variational
+//! equations with the saltation matrix at each switching (Leine & Nijmeijer 2004, ch. 7), driven
+//! by the fluctuation–dissipation theorem's white force, the diffusion D = GGᵀ of the
+//! stochastic step ([`crate::integrate::exact::noise`]; the region's damping under the linear
+//! law, the lever's and the medium's under a nonlinear one). Over a part (τ_a, τ_b) of the
+//! period δz ↦ Φ δz + ξ, Φ = Φ(τ_b, τ_a) the flow's Jacobian ([`crate::maps::flow`]: the step
+//! Jacobians and the saltation matrices) and ξ Gaussian with covariance
+//! ∫ Φ(τ_b,s) D Φ(τ_b,s)ᵀ ds. That integral is exact (Van Loan's block exponential,
+//! [`crate::integrate::exact::noise`]) over a part without a switching where the motion is
+//! linear (the linear law in either region; free flight under a law that does not act outside
+//! contact); elsewhere it is the trapezoid rule h/2 (Φ D_a Φᵀ + D_b), whose relative error is
+//! (ωh)²/12 for a motion of rate ω: parts of ωh ≤ [`ETA`] = 2π/512 put it near 10⁻⁵.
+//! Observer states (a lock-in's sums) extend the deviation: the chain is y ↦ F y + ξ over the
+//! period, F the product of the parts' maps and ξ's covariance W the noise of every part carried
+//! through every later map. The stationary covariance Y = F Y Fᵀ + W (the discrete Lyapunov
+//! equation) is summed by doubling, Y = Σ_k F^k W F^kᵀ (R. A. Smith, "Matrix equation
+//! XA + BX = C", *SIAM J. Appl. Math.* 16 (1968) 198–201); at a time t of the period the
+//! covariance is F_t Y F_tᵀ + W_t, (F_t, W_t) the chain from the period's start to t.
+//!
+//! This is the linear response of the measurement itself. It holds while σ stays small against
+//! the orbit's distance to grazing (a switching that the noise can remove or add is outside any
+//! linearisation), and only for a stable orbit (an unstable one has no stationary covariance).
+//! Units are the model's: τ (eq. 5), lengths in g₀, k_B T in the model's energy unit.
+
+use crate::error::SimError;
+use crate::galerkin::Region;
+use crate::integrate::exact::noise::{
+    admits_model, contact_rate, diffusion, linear_part, van_loan,
+};
+use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::maps::flow::{flow, FlowMap};
+use crate::model::CantileverModel;
+use nalgebra::{DMatrix, DVector};
+
+/// The largest ωh of a part whose noise is summed by the trapezoid rule (module docs): 512 parts
+/// per period of the motion's rate ω.
+pub const ETA: f64 = std::f64::consts::TAU / 512.0;
+
+/// The doubling's iterations at most: F^(2^k) has gone below 10⁻¹⁵ of the unit for any stable
+/// chain whose slowest decay per period is 1 − 10⁻¹⁵ or faster.
+const DOUBLINGS: usize = 64;
+
+/// The chain y ↦ F y + ξ, ξ ~ N(0, W), from the period's start to the walk's time (module docs).
+#[derive(Debug, Clone)]
+pub(crate) struct Chain {
+    /// F, (2N + observers)².
+    pub f: DMatrix<f64>,
+    /// W, the noise injected so far carried to the walk's time.
+    pub w: DMatrix<f64>,
+}
+
+impl Chain {
+    /// F ← M F, W ← M W Mᵀ: a linear map `m` of the deviation and the observers.
+    pub(crate) fn apply(&mut self, m: &DMatrix<f64>) {
+        self.f = m * &self.f;
+        self.w = m * &self.w * m.transpose();
+    }
+
+    /// The stationary covariance Y = F Y Fᵀ + W by doubling (module docs): `None` where
+    /// F^(2^k) does not go to zero (an unstable or marginal chain).
+    pub(crate) fn stationary(&self) -> Option<DMatrix<f64>> {
+        let (mut a, mut y) = (self.f.clone(), self.w.clone());
+        for _ in 0..DOUBLINGS {
+            y += &a * &y * a.transpose();
+            a = &a * &a;
+            let size = a.amax();
+            if !size.is_finite() || size > 1e12 {
+                return None;
+            }
+            if size < 1e-15 {
+                return Some(0.5 * (&y + y.transpose()));
+            }
+        }
+        None
+    }
+
+    /// gᵀ(F Y Fᵀ + W)g: the variance of the linear form g of the deviation at the walk's time,
+    /// `y` the stationary covariance at the period's start.
+    pub(crate) fn variance(&self, y: &DMatrix<f64>, g: &DVector<f64>) -> f64 {
+        let fg = self.f.transpose() * g;
+        (fg.dot(&(y * &fg)) + g.dot(&(&self.w * g))).max(0.0)
+    }
+}
+
+/// The walk along the orbit that builds the [`Chain`] part by part.
+pub(crate) struct Walk<'a> {
+    model: &'a CantileverModel,
+    /// The lever without the sample (its A_s and the diffusion's damping).
+    linear: CantileverModel,
+    integ: Box<dyn Integrator>,
+    /// D per region.
+    d: [DMatrix<f64>; 2],
+    /// The region at `tau`.
+    region: Region,
+    /// The exact noise of the last part length of each region, (ℓ, Q).
+    exact: [Option<(f64, DMatrix<f64>)>; 2],
+    /// τ of the walk.
+    pub tau: f64,
+    /// The orbit's state at `tau`.
+    pub state: DVector<f64>,
+    /// The chain from the start to `tau`.
+    pub chain: Chain,
+}
+
+impl<'a> Walk<'a> {
+    /// The walk from (0, `z`) on `model` at k_B T = `kt` (model units), the chain's deviation
+    /// followed by `observers` states.
+    ///
+    /// # Errors
+    /// [`SimError::Unsupported`] for a law with memory, [`SimError::OutOfRange`] naming `drive`
+    /// for a multifrequency drive ([`admits_model`]); the integrator's.
+    pub(crate) fn new(
+        model: &'a CantileverModel,
+        z: &DVector<f64>,
+        kt: f64,
+        observers: usize,
+        options: IntegratorOptions,
+    ) -> Result<Self, SimError> {
+        admits_model(model.params())?;
+        let linear = linear_part(model)?;
+        let d = [Region::Free, Region::Contact].map(|r| diffusion(&linear, r, kt));
+        let n = z.len() + observers;
+        Ok(Walk {
+            integ: build(model, options, 0.0, z)?,
+            linear,
+            d,
+            region: model.region_at(0.0, z),
+            exact: [None, None],
+            tau: 0.0,
+            state: z.clone(),
+            chain: Chain {
+                f: DMatrix::identity(n, n),
+                w: DMatrix::zeros(n, n),
+            },
+            model,
+        })
+    }
+
+    /// The part to `t1` (module docs).
+    ///
+    /// # Errors
+    /// The flow's.
+    pub(crate) fn part(&mut self, t1: f64) -> Result<(), SimError> {
+        let fl = self.flow(t1)?;
+        self.take(fl, t1);
+        Ok(())
+    }
+
+    /// A part toward `end` of at most `h` and of ω_c ℓ ≤ [`ETA`] at both its ends (ω_c the
+    /// contact's rate, [`contact_rate`]; halved until it holds, to ℓ ≥ 10⁻⁹ h): the parts of a
+    /// walk whose times are free.
+    ///
+    /// # Errors
+    /// The flow's.
+    pub(crate) fn adaptive_part(&mut self, end: f64, h: f64) -> Result<(), SimError> {
+        let rate = |tau: f64, z: &DVector<f64>| contact_rate(self.model, tau, z);
+        let mut len = h.min(ETA / rate(self.tau, &self.state)).min(end - self.tau);
+        loop {
+            let t1 = if len >= end - self.tau {
+                end
+            } else {
+                self.tau + len
+            };
+            let fl = self.flow(t1)?;
+            if len * rate(t1, &fl.state) <= ETA || len < 1e-9 * h {
+                self.take(fl, t1);
+                return Ok(());
+            }
+            len *= 0.5;
+        }
+    }
+
+    /// The flow from the walk's time to `t1`.
+    fn flow(&mut self, t1: f64) -> Result<FlowMap, SimError> {
+        flow(self.integ.as_mut(), self.tau, &self.state, t1, None, false)
+    }
+
+    /// Whether the motion in `r` is linear (module docs).
+    fn linear_in(&self, r: Region) -> bool {
+        let law = self.model.law();
+        law.is_affine() || (r == Region::Free && !law.acts_outside())
+    }
+
+    /// The noise of the part to `t1` (module docs), the flow `fl` over it.
+    fn noise(&mut self, fl: &FlowMap, t1: f64, to: Region) -> DMatrix<f64> {
+        let h = t1 - self.tau;
+        let from = self.region;
+        if fl.switchings == 0 && from == to && self.linear_in(from) {
+            let i = from.index();
+            if let Some((l, q)) = &self.exact[i] {
+                if *l == h {
+                    return q.clone();
+                }
+            }
+            let a = &self.linear.dynamics(from).a;
+            let (_, q) = van_loan(a, &self.d[i], h);
+            self.exact[i] = Some((h, q.clone()));
+            return q;
+        }
+        let j = &fl.jacobian;
+        (j * &self.d[from.index()] * j.transpose() + &self.d[to.index()]) * (0.5 * h)
+    }
+
+    /// Take the part to `t1` of flow `fl`.
+    fn take(&mut self, fl: FlowMap, t1: f64) {
+        let to = self.model.region_at(t1, &fl.state);
+        let q = self.noise(&fl, t1, to);
+        let (n, dim) = (self.chain.f.nrows(), fl.state.len());
+        let mut m = DMatrix::identity(n, n);
+        m.view_mut((0, 0), (dim, dim)).copy_from(&fl.jacobian);
+        self.chain.apply(&m);
+        let mut top = self.chain.w.view_mut((0, 0), (dim, dim));
+        top += &q;
+        (self.state, self.tau, self.region) = (fl.state, t1, to);
+    }
+}
