@@ -31,6 +31,22 @@ def test_peakforce_equals_the_command_line(cli_json, tmp_path):
     assert adhesion * (1 + 1e-9) <= force.min() <= adhesion * (1 - 5e-3)
 
 
+def test_peakforce_temperature_equals_the_command_line(cli_json, tmp_path):
+    # the thermal block's σ (the library's linear response, tested there against a simulated
+    # lever and equipartition) reaches the dataset's attributes as the command line's
+    doc = cli_json(
+        "peakforce", "--probe", AIR, "--z-c", "97nm", "--temperature", "295", "--files", "none"
+    )
+    ds = afmdyn.peakforce(probe=AIR, z_c=97e-9, temperature=295.0)
+    thermal = json.loads(ds.attrs["summary"])["thermal"]
+    assert thermal == doc["thermal"]
+    assert ds.attrs["peak_force_noise"] == doc["thermal"]["peak_force_noise"] > 0
+    assert ds.attrs["deformation_noise"] == doc["thermal"]["deformation_noise"] > 0
+    assert "peak_force_noise" not in afmdyn.peakforce(probe=AIR, z_c=97e-9).attrs
+    with pytest.raises(ValueError, match="temperature"):
+        afmdyn.peakforce(probe=AIR, z_c=97e-9, temperature=-5.0)
+
+
 def test_bad_peakforce_options_name_them():
     with pytest.raises(ValueError, match="setpoint"):
         afmdyn.peakforce(probe=AIR, setpoint=-1e-9)

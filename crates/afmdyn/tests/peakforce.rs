@@ -651,3 +651,73 @@ fn a_modulation_too_slow_for_the_integrator_is_refused_by_its_key() {
     assert!(at(1.01 * f_min).is_ok());
     assert!(at(0.99 * f_min).is_err());
 }
+
+/// `peakforce --temperature` (issue 79 item 3): the `"thermal"` block's σ of the deformation and
+/// the peak force against equipartition in contact. A point-mass lever (0.4 N/m, 70 kHz, Q = 2,
+/// water-like damping) pressed slowly (f₀/f_m = 100) 10 nm into a linear sample of 2 N/m
+/// rests in contact for tens of its relaxation times Q/(πf₀): at the top of the modulation its
+/// deviation is the contact oscillator's stationary one, whose noise and damping are the
+/// lever's, so ⟨δx²⟩ = k_BT/(k + k_s) (the fluctuation–dissipation theorem; Callen & Welton
+/// 1951) and σ_F = k_s σ_x, within 1 %. σ scales as √T (linear response), and the laws with
+/// memory, a temperature without a probe and one out of range are refused naming it.
+#[test]
+fn a_temperature_gives_the_taps_thermal_noise() {
+    use afmdyn::request::{named, Resolved};
+    let text = "model = \"point-mass\"\n[cantilever]\nspring_constant = 0.4\n\
+                resonance_frequency = 70e3\nquality_factor = 2\n[tip]\nradius = 10e-9\n\
+                [sample]\nlaw = \"linear\"\nstiffness = 2.0\nz_c = 10e-9\n\
+                [drive]\nmode = \"off-resonance\"\nmodulation_frequency = 700\n\
+                modulation_amplitude = 20e-9\n";
+    let probe = afmdyn::probe::Probe::parse(text, "pressed").unwrap();
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let run = |t: f64| {
+        let r = named::parse("peakforce", serde_json::json!({"temperature": t}))
+            .unwrap()
+            .unwrap();
+        r.run(&model, &Default::default()).unwrap().document
+    };
+    let doc = run(295.0);
+    let th = &doc["thermal"];
+    let (k, ks) = (0.4_f64, 2.0_f64);
+    let sigma_x = (1.380_649e-23 * 295.0 / (k + ks)).sqrt();
+    let deformation = th["deformation_noise"].as_f64().unwrap();
+    let force = th["peak_force_noise"].as_f64().unwrap();
+    println!("σ_δ = {deformation:.5e} m (equipartition {sigma_x:.5e}), σ_F = {force:.5e} N");
+    assert!((deformation / sigma_x - 1.0).abs() < 0.01, "{th}");
+    assert!((force / (ks * sigma_x) - 1.0).abs() < 0.01, "{th}");
+    assert_eq!(th["units"]["peak_force_noise"], "N");
+    let hot = run(4.0 * 295.0)["thermal"]["peak_force_noise"]
+        .as_f64()
+        .unwrap();
+    assert!((hot / force - 2.0).abs() < 1e-9, "{hot} vs {force}");
+    // without a temperature, no block
+    let cold = named::parse("peakforce", serde_json::json!({}))
+        .unwrap()
+        .unwrap();
+    let cold = cold.run(&model, &Default::default()).unwrap().document;
+    assert!(cold["thermal"].is_null());
+    // refusals: out of range, without a probe's units, a law with memory
+    let refused = |keywords: serde_json::Value, model: &Resolved| {
+        let r = named::parse("peakforce", keywords).unwrap().unwrap();
+        r.run(model, &Default::default()).unwrap_err().to_string()
+    };
+    let e = refused(serde_json::json!({"temperature": -3.0}), &model);
+    assert!(e.contains("temperature"), "{e}");
+    let plain = Resolved::plain(point_mass(ContactLaw::Hertz, 10.0, 20.0, 20.0, 0.9));
+    let e = refused(serde_json::json!({"temperature": 295.0}), &plain);
+    assert!(e.contains("temperature") && e.contains("probe"), "{e}");
+    let jkr = text.replace(
+        "law = \"linear\"\nstiffness = 2.0",
+        "law = \"jkr\"\nyoungs_modulus = 1e9\npoisson_ratio = 0.4\nadhesion_energy = 0.05",
+    );
+    let jkr = afmdyn::probe::Probe::parse(&jkr, "jkr").unwrap();
+    let jkr = Resolved {
+        params: jkr.params,
+        probe: Some(jkr),
+    };
+    let e = refused(serde_json::json!({"temperature": 295.0}), &jkr);
+    assert!(e.contains("jkr"), "{e}");
+}

@@ -428,6 +428,7 @@ PeakForceRequest = TypedDict(
         "samples": int,  # default 4096
         "setpoint": Optional[float],  # default null
         "sweep": Optional[PeakForceSweep],  # default null
+        "temperature": Optional[float],  # default null
         "z_c": Optional[float],  # default null
     },
     total=False,

@@ -33,6 +33,10 @@ def _finish_peakforce(a: Dict[str, Any]) -> xr.Dataset:
     )
     if doc.get("sweep") is None:
         ds.attrs = {k: v for k, v in doc["channels"].items() if v is not None}
+        # the thermal block's σ beside the channels they are the noise of (with temperature)
+        for k in ("peak_force_noise", "deformation_noise"):
+            if (doc.get("thermal") or {}).get(k) is not None:
+                ds.attrs[k] = doc["thermal"][k]
     else:
         ds.attrs = {}
     ds.attrs["summary"] = json.dumps(doc)

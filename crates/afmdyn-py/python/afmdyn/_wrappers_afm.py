@@ -802,6 +802,7 @@ def peakforce(
     fit_band: Optional[Sequence[float]] = None,
     samples: int = 4096,
     setpoint: Optional[float] = None,
+    temperature: Optional[float] = None,
     z_c: Union[float, Sequence[float], None] = None,
     modulation_frequency: Optional[Sequence[float]] = None,
     progress: ProgressArg = None,
@@ -824,6 +825,14 @@ def peakforce(
         samples: Points of the reported cycle, in 2000..=1000000 (default 4096).
         setpoint: The peak force the ideal feedback holds (N with a probe, else F̃), > 0:
             z_c is found so that the steady tap's peak force equals it. Excludes ``z_c``.
+        temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
+            200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
+            the document gains a ``"thermal"`` block: the standard deviations, from cycle to
+            cycle, of the tap's peak force and deformation under the lever's thermal force,
+            by linear response about the steady tap (``analysis::peakforce::tap_noise``);
+            with a sweep, those of the single-tap blocks' tap (its first computed value).
+            Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact)
+            are refused.
         z_c: The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance
             with the lever at rest and the sample at the centre of its modulation; default
             the model's (the probe's ``[sample] z_c``, default A_m). Excludes ``setpoint``.

@@ -76,14 +76,12 @@ pub fn lock_in_noise(
     samples: usize,
 ) -> Result<LockInNoise, SimError> {
     crate::error::within("samples", samples, 1..=usize::MAX, "must be at least 1")?;
-    for (name, v) in [("kt", kt), ("time_constant", time_constant)] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(SimError::out_of_range(
-                name,
-                v,
-                "must be a finite number ≥ 0",
-            ));
-        }
+    if !(time_constant.is_finite() && time_constant >= 0.0) {
+        return Err(SimError::out_of_range(
+            "time_constant",
+            time_constant,
+            "must be a finite number ≥ 0",
+        ));
     }
     let (chain, harmonic) = period_chain(model, z, kt, time_constant, samples)?;
     let Some(y) = chain.stationary() else {

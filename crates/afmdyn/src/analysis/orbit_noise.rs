@@ -112,8 +112,9 @@ impl<'a> Walk<'a> {
     /// followed by `observers` states.
     ///
     /// # Errors
-    /// [`SimError::Unsupported`] for a law with memory, [`SimError::OutOfRange`] naming `drive`
-    /// for a multifrequency drive ([`admits_model`]); the integrator's.
+    /// [`SimError::OutOfRange`] naming `kt` (negative or not finite) or `drive` (a
+    /// multifrequency drive), [`SimError::Unsupported`] for a law with memory
+    /// ([`admits_model`]); the integrator's.
     pub(crate) fn new(
         model: &'a CantileverModel,
         z: &DVector<f64>,
@@ -121,6 +122,13 @@ impl<'a> Walk<'a> {
         observers: usize,
         options: IntegratorOptions,
     ) -> Result<Self, SimError> {
+        if !(kt.is_finite() && kt >= 0.0) {
+            return Err(SimError::out_of_range(
+                "kt",
+                kt,
+                "must be a finite number ≥ 0",
+            ));
+        }
         admits_model(model.params())?;
         let linear = linear_part(model)?;
         let d = [Region::Free, Region::Contact].map(|r| diffusion(&linear, r, kt));

@@ -35,11 +35,13 @@
 
 mod filter;
 mod fit;
+mod noise;
 mod setpoint;
 
 pub use filter::low_pass_periodic;
 pub(crate) use fit::MIN_FIT_POINTS;
 pub use fit::{fit_dmt, DmtFit, FIT_BAND};
+pub use noise::{tap_noise, TapNoise};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,
     SETPOINT_TOL,

@@ -156,7 +156,7 @@ pub(crate) const TRACE_GROWTH: f64 = 3.5;
 /// products of its chain. Measured 2 ms a point against 0.125 ms a simulated period
 /// (`approach --points 60 --no-branches` with and without `--temperature`, `simulate --periods
 /// 2000`, examples/probe-beam-dmt.toml): 16 periods.
-const NOISE_PERIODS: f64 = 16.0;
+pub(crate) const NOISE_PERIODS: f64 = 16.0;
 
 /// The cost of a stepped curve (`approach`, `resonance`): every point's steady state (one way,
 /// and back with branches: each value twice), up to `max_branch_points` Newton solves of the

@@ -5,7 +5,7 @@
 //! share (its document is made where it runs). With a probe everything is SI (m, N, J, s, Pa); without one the
 //! model's units (g₀, F̃, F̃·g₀, τ).
 
-use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
+use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES, NOISE_PERIODS};
 use super::limits::Cost;
 use super::run::Resolved;
 use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, FIT_BAND, SETPOINT_ITERATIONS};
@@ -27,6 +27,11 @@ pub(crate) fn first_natural_frequency(p: &Params) -> f64 {
         crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
     })
 }
+
+/// The thermal block's parts against the free lever's 512 per lever period (the contact's are
+/// shorter): 1.7 measured on examples/probe-peakforce-air.toml at z_c = 97 nm (30 109 parts
+/// for 17 920, 6.8 µs each), 1.04 on examples/probe-peakforce-amo-garcia.toml.
+const NOISE_CONTACT: f64 = 2.0;
 
 request! {
     /// `peakforce`: one steady off-resonance tap at `z_c` (m with a probe, else g₀) or at the z_c
@@ -61,6 +66,15 @@ request! {
         /// `setpoint` a sweep in the modulation frequency holds the peak force at every value.
         /// `None` (default): one tap.
         pub sweep: Option<PeakForceSweep>,
+        /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
+        /// a value in °C?); `None` (the default): no noise. With one the document gains a
+        /// `"thermal"` block: the standard deviations, from cycle to cycle, of the tap's peak
+        /// force and deformation under the lever's thermal force, by linear response about the
+        /// steady tap ([`crate::analysis::peakforce::tap_noise`]); with a sweep, those of the
+        /// single-tap blocks' tap (its first computed value). Needs the probe's SI units; the
+        /// laws with memory (JKR, capillary, SLS, impact) are refused.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub temperature: Option<f64>,
     }
 }
 
@@ -150,11 +164,26 @@ impl PeakForceRequest {
             (None, None) => {}
         }
         q.validate()?;
+        self.thermal(model)?;
         self.check_steps(model, &q)?;
         if let Some(sweep) = &self.sweep {
             self.sweep_points(sweep, model, &q)?;
         }
         Ok(q)
+    }
+
+    /// k_B T of the `"thermal"` block (model units): `None` without a temperature.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe);
+    /// [`SimError::Unsupported`] for a law with memory.
+    pub(crate) fn thermal(&self, model: &Resolved) -> Result<Option<f64>, SimError> {
+        let Some(t) = self.temperature else {
+            return Ok(None);
+        };
+        let kt = super::limits::thermal_force(t, 0, model.probe.as_ref())?.kt;
+        crate::integrate::exact::noise::admits_model(&model.params)?;
+        Ok(Some(kt))
     }
 
     /// The integrator's steps per modulation period on `p` against its budget
@@ -300,6 +329,15 @@ impl_request! {
             1.0
         };
         let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
+        // the thermal block's walk over the tap: 512 parts per lever period, each like the
+        // lock-in's (NOISE_PERIODS per 512 parts), more in contact (NOISE_CONTACT)
+        let noise = match r.temperature {
+            Some(_) => {
+                let lever_periods = first_natural_frequency(&p) / p.omega;
+                NOISE_CONTACT * NOISE_PERIODS * p.modes as f64 * lever_periods
+            }
+            None => 0.0,
+        };
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
         // fits, multipliers and state, and the value's model
         let record = 2048.0 + 8.0 * state_bytes(&p) + std::mem::size_of::<Params>() as f64;
@@ -313,7 +351,7 @@ impl_request! {
                 + 64.0 * state_bytes(&p)
                 + points.len() as f64 * record,
             // and the reported cycle's samples, each under a mode-period (1.3 µs measured)
-            work: taps * tap + r.samples as f64,
+            work: taps * tap + r.samples as f64 + noise,
         })
     };
     computed_at |r, model| r.params(model)

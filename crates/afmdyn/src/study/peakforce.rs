@@ -17,8 +17,8 @@
 use super::peakforce_sweep::SweepTap;
 use super::Chain;
 use crate::analysis::peakforce::{
-    low_pass_periodic, peak_force_setpoint, static_compliance, steady_tap, steady_tap_from, Cycle,
-    PeakForceOptions, SetpointOptions, SteadyTap,
+    low_pass_periodic, peak_force_setpoint, static_compliance, steady_tap, steady_tap_from,
+    tap_noise, Cycle, PeakForceOptions, SetpointOptions, SteadyTap, TapNoise,
 };
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -136,41 +136,13 @@ impl Analysis for PeakForceRequest {
         }
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
-        let p = self.params(model)?;
-        if let Some(sweep) = &self.sweep {
-            return execute_sweep(self, sweep, model, &p, progress);
+        let mut r = self.tap(model, progress)?;
+        if let Some(kt) = self.thermal(model)? {
+            let m = CantileverModel::new(&tap_params(model, &r))?;
+            let integrator = self.options().integrator;
+            r.noise = Some(tap_noise(&m, &r.tap.state, r.tap.period, kt, integrator)?);
         }
-        match self.setpoint {
-            Some(f) => {
-                let force = model.units(true).force;
-                let opts = SetpointOptions {
-                    tap: self.options(),
-                    ..SetpointOptions::default()
-                };
-                let s =
-                    peak_force_setpoint(&p, f / force, &opts).map_err(|e| match model.probe {
-                        Some(_) => setpoint_in_newtons(e, f),
-                        None => e,
-                    })?;
-                Ok(PeakForceResult {
-                    alpha5: s.alpha5,
-                    filtered: self.filtered(model, &p, &s.tap)?,
-                    tap: s.tap,
-                    evaluations: s.evaluations,
-                    sweep: None,
-                })
-            }
-            None => {
-                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
-                Ok(PeakForceResult {
-                    alpha5: p.alpha5,
-                    filtered: self.filtered(model, &p, &tap)?,
-                    tap,
-                    evaluations: 1,
-                    sweep: None,
-                })
-            }
-        }
+        Ok(r)
     }
     fn found_at(&self, model: &Resolved, r: &PeakForceResult) -> Result<Params, SimError> {
         // a setpoint's z_c is the one found; a sweep keeps the probe's (its values are listed)
@@ -238,6 +210,7 @@ fn execute_sweep(
         evaluations: taps.iter().map(|t| t.evaluations).sum(),
         tap,
         sweep: Some(taps),
+        noise: None,
     })
 }
 
@@ -255,6 +228,8 @@ pub struct PeakForceResult {
     pub filtered: Option<Vec<f64>>,
     /// Every value's tap of [`PeakForceRequest::sweep`], in its order.
     pub sweep: Option<Vec<SweepTap>>,
+    /// The tap's thermal noise (with [`PeakForceRequest::temperature`]).
+    pub noise: Option<TapNoise>,
 }
 
 /// The filter's words in the document (`filter.kind`).
@@ -347,6 +322,17 @@ pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
     true_modulus(model, 1.0).filter(|_| has_radius)
 }
 
+/// The model of the single-tap blocks' tap: a sweep's first computed value's (its Ω in a sweep
+/// of f_m) at the tap's α5.
+fn tap_params(model: &Resolved, r: &PeakForceResult) -> Params {
+    r.sweep
+        .iter()
+        .flatten()
+        .find(|t| t.tap.is_some())
+        .map_or(model.params, |t| t.params)
+        .with(SweepParam::Alpha5, r.alpha5)
+}
+
 /// The document of a steady tap (`afmdyn peakforce --json`, Python's `to_dict()`): `channels`
 /// (the instrument's, SI with a probe), `modulus` (the DMT fit beside the true modulus),
 /// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
@@ -357,13 +343,7 @@ pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakFor
     let tap = &r.tap;
     let c = &tap.channels;
     // a sweep's single-tap blocks are its first computed value's (its Ω in a sweep of f_m)
-    let p = r
-        .sweep
-        .iter()
-        .flatten()
-        .find(|t| t.tap.is_some())
-        .map_or(model.params, |t| t.params)
-        .with(SweepParam::Alpha5, r.alpha5);
+    let p = tap_params(model, r);
     let has_radius = p.contact_law.info().tip_radius;
     // the fitted Hertz group to a modulus (SI with a probe), beside the true one
     let fitted = tap.fit.map(|f| f.hertz_group);
@@ -449,9 +429,63 @@ pub(crate) fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakFor
             "kind": FILTER_KIND,
         })),
         "units": units_block(u.si),
+        "thermal": thermal_block(request, r, &u, &mut warnings),
         "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/tutorials/peakforce.md)",
         "warnings": warnings,
     })
+}
+
+/// σ/channel above which the thermal block's linear response is said to be at its limit.
+pub(crate) const MAX_LINEAR_NOISE: f64 = 0.1;
+
+/// The document's `thermal` block (`None` without a temperature): the tap's noise per cycle
+/// ([`crate::analysis::peakforce::tap_noise`]) in the document's units, the temperature's
+/// warnings and, where σ passes [`MAX_LINEAR_NOISE`] of its channel, the linear response's.
+fn thermal_block(
+    request: &PeakForceRequest,
+    r: &PeakForceResult,
+    u: &CurveUnits,
+    warnings: &mut Vec<String>,
+) -> Option<Value> {
+    let (n, t) = (r.noise?, request.temperature?);
+    warnings.extend(crate::request::limits::temperature_warnings(t));
+    let c = &r.tap.channels;
+    let large = [
+        ("peak force", n.peak_force, c.peak_force),
+        ("deformation", n.deformation, c.deformation),
+    ]
+    .into_iter()
+    .filter(|&(_, sigma, value)| sigma > MAX_LINEAR_NOISE * value.abs())
+    .map(|(name, ..)| name)
+    .collect::<Vec<_>>();
+    if !large.is_empty() {
+        let (what, percent) = (large.join(" and "), MAX_LINEAR_NOISE * 100.0);
+        warnings.push(warning!(
+            "thermal.noise-large",
+            "Read the thermal block as an estimate; the peaks' distribution is then skewed.",
+            "the thermal noise of the {what} is more than {percent:.0} % of the channel \
+             itself: its linear response about the steady tap is at its limit (the noise may \
+             make or break contact, which no linearisation holds)"
+        ));
+    }
+    if n.snap_in {
+        warnings.push(warning!(
+            "thermal.snap-in",
+            "Read the σ as the typical cycle's spread; a thermally driven run of the tap \
+             (simulate --temperature) shows the rare hard taps.",
+            "the tap jumps to contact (out of contact the attraction's stiffness passes the \
+             lever's): the noise moves the jump nonlinearly, so the linear response gives the \
+             Gaussian core of the peaks' spread, not its tail of rare hard taps (8× the variance \
+             in a simulated tap on polystyrene, crate::analysis::peakforce::tap_noise)"
+        ));
+    }
+    Some(json!({
+        "temperature": t,
+        "peak_force_noise": n.peak_force * u.force,
+        "deformation_noise": n.deformation * u.length,
+        "units": if u.si { json!({"temperature": "K", "peak_force_noise": "N", "deformation_noise": "m"}) } else { json!({"temperature": "K", "peak_force_noise": "F", "deformation_noise": "g0"}) },
+        "method": "standard deviations from cycle to cycle of the peak force and the deformation under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
+    }))
 }
 
 /// A column of the cycle in the document's units.
@@ -617,7 +651,13 @@ impl crate::study::named::Datasets for PeakForceRequest {
             &[("approach", a), ("retract", b)],
             variables,
         );
-        let facts = doc["channels"].as_object().cloned().unwrap_or_default();
+        let mut facts = doc["channels"].as_object().cloned().unwrap_or_default();
+        // the thermal block's σ beside the channels they are the noise of
+        if let Some(th) = doc["thermal"].as_object() {
+            for k in ["peak_force_noise", "deformation_noise"] {
+                facts.insert(k.into(), th[k].clone());
+            }
+        }
         let mut layouts = vec![("cycle".into(), cycle), ("curve".into(), curve)];
         if let Some((s, taps)) = self.sweep.as_ref().zip(r.sweep.as_ref()) {
             // the contact law, and so its tip radius, is the same at every value of a sweep
@@ -630,6 +670,48 @@ impl crate::study::named::Datasets for PeakForceRequest {
 }
 
 impl PeakForceRequest {
+    /// The steady tap of the request: at its z_c, its setpoint, or a sweep's (the first value
+    /// computed giving the single tap's blocks), without its noise.
+    fn tap(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
+        let p = self.params(model)?;
+        if let Some(sweep) = &self.sweep {
+            return execute_sweep(self, sweep, model, &p, progress);
+        }
+        match self.setpoint {
+            Some(f) => {
+                let force = model.units(true).force;
+                let opts = SetpointOptions {
+                    tap: self.options(),
+                    ..SetpointOptions::default()
+                };
+                let s =
+                    peak_force_setpoint(&p, f / force, &opts).map_err(|e| match model.probe {
+                        Some(_) => setpoint_in_newtons(e, f),
+                        None => e,
+                    })?;
+                Ok(PeakForceResult {
+                    alpha5: s.alpha5,
+                    filtered: self.filtered(model, &p, &s.tap)?,
+                    tap: s.tap,
+                    evaluations: s.evaluations,
+                    sweep: None,
+                    noise: None,
+                })
+            }
+            None => {
+                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
+                Ok(PeakForceResult {
+                    alpha5: p.alpha5,
+                    filtered: self.filtered(model, &p, &tap)?,
+                    tap,
+                    evaluations: 1,
+                    sweep: None,
+                    noise: None,
+                })
+            }
+        }
+    }
+
     /// The measured force k × deflection (the deflection over the static compliance) of the
     /// tap's cycle through the filter of [`PeakForceRequest::filter_cutoff`], F̃.
     pub(crate) fn filtered(

@@ -237,6 +237,15 @@ fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Optio
             fit / truth
         ));
     }
+    let th = &document["thermal"];
+    if th.is_object() {
+        p.line(format!(
+            "thermal noise at {} K, per cycle: σ(peak force) = {}, σ(deformation) = {}",
+            num(&th["temperature"]),
+            value(num(&th["peak_force_noise"]), "N", "F"),
+            value(num(&th["deformation_noise"]), "m", "g0"),
+        ));
+    }
     let o = &document["orbit"];
     p.line(format!(
         "orbit: period {} modulation period(s), {}; largest Floquet multiplier |μ| = {:.3e}",
