@@ -563,7 +563,7 @@ pub struct PeakForceFlags {
     #[arg(long, default_value = "4096", help = "Points of the reported cycle, in 2000..=1000000 (default 4096).")]
     pub samples: usize,
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: the standard deviations, from cycle to cycle, of the tap's peak force and deformation under the lever's thermal force, by linear response about the steady tap; with a sweep, those of the single-tap blocks' tap (its first computed value). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) are refused.")]
+    #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: the standard deviations, from cycle to cycle, of the tap's peak force and deformation under the lever's thermal force, by linear response about the steady tap; a sweep gains them as the channels peak_force_noise and deformation_noise of every value (the block is the single-tap blocks' tap's). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) are refused.")]
     pub temperature: Option<f64>,
 }
 

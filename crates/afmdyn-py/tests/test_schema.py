@@ -145,6 +145,9 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
     ("image", PF_IMAGE),
     ("peakforce", ["--probe", PF]),
+    # the thermal block, and the noise channels of a sweep
+    ("peakforce", ["--probe", PF, "--temperature", 295, "--from", "90nm", "--to", "89nm",
+                   "--step", "1nm", "--files", "none"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus,contact_point",
              "--files", "data"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus",

@@ -658,8 +658,9 @@ fn a_modulation_too_slow_for_the_integrator_is_refused_by_its_key() {
 /// rests in contact for tens of its relaxation times Q/(πf₀): at the top of the modulation its
 /// deviation is the contact oscillator's stationary one, whose noise and damping are the
 /// lever's, so ⟨δx²⟩ = k_BT/(k + k_s) (the fluctuation–dissipation theorem; Callen & Welton
-/// 1951) and σ_F = k_s σ_x, within 1 %. σ scales as √T (linear response), and the laws with
-/// memory, a temperature without a probe and one out of range are refused naming it.
+/// 1951) and σ_F = k_s σ_x, within 1 %. σ scales as √T (linear response); a sweep carries each
+/// value's noise; the laws with memory, a temperature without a probe and one out of range are
+/// refused naming it.
 #[test]
 fn a_temperature_gives_the_taps_thermal_noise() {
     use afmdyn::request::{named, Resolved};
@@ -693,6 +694,22 @@ fn a_temperature_gives_the_taps_thermal_noise() {
         .as_f64()
         .unwrap();
     assert!((hot / force - 2.0).abs() < 1e-9, "{hot} vs {force}");
+    // a sweep in z_c carries every value's noise as channels: at the probe's z_c the single
+    // tap's (the same orbit, continued or from rest, to Newton's tolerance)
+    let sweep = serde_json::json!({"temperature": 295.0,
+        "sweep": {"quantity": "z_c", "values": [10e-9, 9e-9]}});
+    let r = named::parse("peakforce", sweep).unwrap().unwrap();
+    let out = r.run(&model, &Default::default()).unwrap();
+    let channels = &out.document["sweep"]["channels"];
+    let swept = channels["peak_force_noise"][0].as_f64().unwrap();
+    assert!((swept / force - 1.0).abs() < 1e-6, "{swept} vs {force}");
+    assert!(channels["deformation_noise"][1].as_f64().unwrap() > 0.0);
+    assert_eq!(out.document["sweep"]["units"]["deformation_noise"], "m");
+    let layout = &out.datasets.iter().find(|(n, _)| n == "sweep").unwrap().1;
+    assert!(layout
+        .variables
+        .iter()
+        .any(|v| v.name == "peak_force_noise"));
     // without a temperature, no block
     let cold = named::parse("peakforce", serde_json::json!({}))
         .unwrap()

@@ -829,10 +829,10 @@ def peakforce(
             200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
             the document gains a ``"thermal"`` block: the standard deviations, from cycle to
             cycle, of the tap's peak force and deformation under the lever's thermal force,
-            by linear response about the steady tap (``analysis::peakforce::tap_noise``);
-            with a sweep, those of the single-tap blocks' tap (its first computed value).
-            Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact)
-            are refused.
+            by linear response about the steady tap (``analysis::peakforce::tap_noise``); a
+            sweep gains them as the channels ``peak_force_noise`` and ``deformation_noise``
+            of every value (the block is the single-tap blocks' tap's). Needs the probe's SI
+            units; the laws with memory (JKR, capillary, SLS, impact) are refused.
         z_c: The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance
             with the lever at rest and the sample at the centre of its modulation; default
             the model's (the probe's ``[sample] z_c``, default A_m). Excludes ``setpoint``.

@@ -70,9 +70,10 @@ request! {
         /// a value in °C?); `None` (the default): no noise. With one the document gains a
         /// `"thermal"` block: the standard deviations, from cycle to cycle, of the tap's peak
         /// force and deformation under the lever's thermal force, by linear response about the
-        /// steady tap ([`crate::analysis::peakforce::tap_noise`]); with a sweep, those of the
-        /// single-tap blocks' tap (its first computed value). Needs the probe's SI units; the
-        /// laws with memory (JKR, capillary, SLS, impact) are refused.
+        /// steady tap ([`crate::analysis::peakforce::tap_noise`]); a sweep gains them as the
+        /// channels `peak_force_noise` and `deformation_noise` of every value (the block is the
+        /// single-tap blocks' tap's). Needs the probe's SI units; the laws with memory (JKR,
+        /// capillary, SLS, impact) are refused.
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
     }
@@ -329,13 +330,16 @@ impl_request! {
             1.0
         };
         let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
-        // the thermal block's walk over the tap: 512 parts per lever period, each like the
+        // the thermal noise's walk over each tap: 512 parts per lever period, each like the
         // lock-in's (NOISE_PERIODS per 512 parts), more in contact (NOISE_CONTACT)
         let noise = match r.temperature {
-            Some(_) => {
-                let lever_periods = first_natural_frequency(&p) / p.omega;
-                NOISE_CONTACT * NOISE_PERIODS * p.modes as f64 * lever_periods
-            }
+            Some(_) => points
+                .iter()
+                .map(|q| first_natural_frequency(q) / q.omega)
+                .sum::<f64>()
+                * NOISE_CONTACT
+                * NOISE_PERIODS
+                * p.modes as f64,
             None => 0.0,
         };
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,

@@ -42,11 +42,41 @@ pub(crate) struct PeakForceStudy {
     pub options: PeakForceOptions,
     /// What a resumed run must match.
     pub fingerprint: Value,
+    /// k_B T of each tap's thermal noise (model units; with a temperature).
+    pub kt: Option<f64>,
 }
 
 impl PeakForceStudy {
-    /// The tap at value `i` from the state `start` at τ = 0.
-    fn tap(&self, i: usize, start: &DVector<f64>) -> Result<(Params, SteadyTap, usize), SimError> {
+    /// The tap at value `i` from the state `start` at τ = 0, with its noise under
+    /// [`PeakForceStudy::kt`].
+    fn tap(&self, i: usize, start: &DVector<f64>) -> Result<SweepTap, SimError> {
+        let (params, tap, evaluations) = self.steady(i, start)?;
+        let noise = match self.kt {
+            Some(kt) => {
+                let (m, integrator) = (
+                    CantileverModel::new(&params)?,
+                    self.options.integrator.clone(),
+                );
+                Some(tap_noise(&m, &tap.state, tap.period, kt, integrator)?)
+            }
+            None => None,
+        };
+        Ok(SweepTap {
+            index: i,
+            params,
+            tap: Some(tap),
+            evaluations,
+            message: None,
+            noise,
+        })
+    }
+
+    /// The steady tap at value `i` from the state `start` at τ = 0.
+    fn steady(
+        &self,
+        i: usize,
+        start: &DVector<f64>,
+    ) -> Result<(Params, SteadyTap, usize), SimError> {
         let p = self.points[i];
         match self.setpoint {
             Some(f) => {
@@ -98,19 +128,14 @@ impl PeakForceStudy {
                 return Err(SimError::Cancelled);
             }
             let record = match self.tap(i, &start) {
-                Ok((params, mut tap, evaluations)) => {
+                Ok(mut record) => {
+                    let tap = record.tap.as_mut().expect("a computed tap");
                     start.copy_from(&tap.state);
                     if shown {
                         tap.cycle = Cycle::default();
                     }
                     shown = true;
-                    SweepTap {
-                        index: i,
-                        params,
-                        tap: Some(tap),
-                        evaluations,
-                        message: None,
-                    }
+                    record
                 }
                 Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                 Err(e) => SweepTap {
@@ -119,6 +144,7 @@ impl PeakForceStudy {
                     tap: None,
                     evaluations: 0,
                     message: Some(e.to_string()),
+                    noise: None,
                 },
             };
             sink(i, record);
@@ -137,7 +163,8 @@ impl Analysis for PeakForceRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
         let mut r = self.tap(model, progress)?;
-        if let Some(kt) = self.thermal(model)? {
+        // a sweep's taps carry their own (the first computed one's is the block's)
+        if let (Some(kt), None) = (self.thermal(model)?, &r.sweep) {
             let m = CantileverModel::new(&tap_params(model, &r))?;
             let integrator = self.options().integrator;
             r.noise = Some(tap_noise(&m, &r.tap.state, r.tap.period, kt, integrator)?);
@@ -189,6 +216,7 @@ fn execute_sweep(
         setpoint: request.setpoint.map(|f| f / force),
         options: request.options(),
         fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": request, "params": p}),
+        kt: request.thermal(model)?,
     };
     let records = super::execute_in_memory(&study.chain(), None, progress)?;
     let taps = super::in_order(records, study.points.len())?;
@@ -208,9 +236,9 @@ fn execute_sweep(
         alpha5: first.params.alpha5,
         filtered: request.filtered(model, &first.params, &tap)?,
         evaluations: taps.iter().map(|t| t.evaluations).sum(),
+        noise: first.noise,
         tap,
         sweep: Some(taps),
-        noise: None,
     })
 }
 
@@ -440,7 +468,8 @@ pub(crate) const MAX_LINEAR_NOISE: f64 = 0.1;
 
 /// The document's `thermal` block (`None` without a temperature): the tap's noise per cycle
 /// ([`crate::analysis::peakforce::tap_noise`]) in the document's units, the temperature's
-/// warnings and, where σ passes [`MAX_LINEAR_NOISE`] of its channel, the linear response's.
+/// warnings and the linear response's, where a tap (of a sweep: any value's) jumps to contact
+/// or its σ passes [`MAX_LINEAR_NOISE`] of its channel.
 fn thermal_block(
     request: &PeakForceRequest,
     r: &PeakForceResult,
@@ -449,15 +478,25 @@ fn thermal_block(
 ) -> Option<Value> {
     let (n, t) = (r.noise?, request.temperature?);
     warnings.extend(crate::request::limits::temperature_warnings(t));
-    let c = &r.tap.channels;
-    let large = [
-        ("peak force", n.peak_force, c.peak_force),
-        ("deformation", n.deformation, c.deformation),
-    ]
-    .into_iter()
-    .filter(|&(_, sigma, value)| sigma > MAX_LINEAR_NOISE * value.abs())
-    .map(|(name, ..)| name)
-    .collect::<Vec<_>>();
+    // every tap's noise beside its channels: the single tap's, or each value's of a sweep
+    let taps: Vec<(TapNoise, &SteadyTap)> = match &r.sweep {
+        Some(s) => (s.iter())
+            .filter_map(|v| Some((v.noise?, v.tap.as_ref()?)))
+            .collect(),
+        None => vec![(n, &r.tap)],
+    };
+    let large = [("peak force", 0), ("deformation", 1)]
+        .into_iter()
+        .filter(|&(_, k)| {
+            taps.iter().any(|(n, tap)| {
+                let c = &tap.channels;
+                let (sigma, value) =
+                    [(n.peak_force, c.peak_force), (n.deformation, c.deformation)][k];
+                sigma > MAX_LINEAR_NOISE * value.abs()
+            })
+        })
+        .map(|(name, _)| name)
+        .collect::<Vec<_>>();
     if !large.is_empty() {
         let (what, percent) = (large.join(" and "), MAX_LINEAR_NOISE * 100.0);
         warnings.push(warning!(
@@ -468,7 +507,7 @@ fn thermal_block(
              make or break contact, which no linearisation holds)"
         ));
     }
-    if n.snap_in {
+    if taps.iter().any(|(n, _)| n.snap_in) {
         warnings.push(warning!(
             "thermal.snap-in",
             "Read the σ as the typical cycle's spread; a thermally driven run of the tap \

@@ -4,22 +4,31 @@
 use crate::analysis::peakforce::SteadyTap;
 use crate::layout::columns::{self, UnitNames};
 use crate::layout::{Layout, Values, Variable};
-pub(crate) use crate::report::present::peakforce::{Frame, SweepTap, COLUMNS};
+pub(crate) use crate::report::present::peakforce::{Frame, SweepTap, COLUMNS, NOISE_COLUMNS};
 use crate::request::PeakForceSweep;
 use serde_json::{json, Value};
 
 /// The `sweep` block of the document: the swept quantity and its values, each channel of
 /// [`COLUMNS`] (`z_c` the feedback's with a setpoint; `modulus_dmt` the frame's modulus scale ×
-/// the fitted Hertz group) over them (`null` where a point failed) and their units, the orbit's
+/// the fitted Hertz group; with a temperature, [`NOISE_COLUMNS`] after them) over them (`null` where a point failed) and their units, the orbit's
 /// period and stability, and each point's message (`null` when computed).
 pub(crate) fn sweep_document(sweep: &PeakForceSweep, frame: &Frame, taps: &[SweepTap]) -> Value {
     let si = frame.u.si;
+    let names = UnitNames::si_or_model(si);
+    let (mut channels, mut units) = (
+        columns::arrays(&COLUMNS, frame, taps),
+        columns::units(&COLUMNS, &names),
+    );
+    if with_noise(taps) {
+        channels.extend(columns::arrays(&NOISE_COLUMNS, frame, taps));
+        units.extend(columns::units(&NOISE_COLUMNS, &names));
+    }
     json!({
         "quantity": sweep.quantity.name(),
         "unit": sweep.quantity.unit(si),
         "values": sweep.values,
-        "channels": columns::arrays(&COLUMNS, frame, taps),
-        "units": columns::units(&COLUMNS, &UnitNames::si_or_model(si)),
+        "channels": channels,
+        "units": units,
         "period": taps.iter().map(|t| t.tap.as_ref().map(|t| t.period)).collect::<Vec<_>>(),
         "stable": taps.iter().map(|t| t.tap.as_ref().map(|t| t.stable)).collect::<Vec<_>>(),
         "transient_periods": taps.iter().map(|t| t.tap.as_ref().map(|t| t.transient_periods)).collect::<Vec<_>>(),
@@ -37,6 +46,12 @@ pub(crate) fn sweep_document(sweep: &PeakForceSweep, frame: &Frame, taps: &[Swee
             })
             .collect::<Vec<Vec<String>>>(),
     })
+}
+
+/// Whether the sweep carries the thermal noise's columns ([`NOISE_COLUMNS`]: run with a
+/// temperature, some tap has its noise).
+fn with_noise(taps: &[SweepTap]) -> bool {
+    taps.iter().any(|t| t.noise.is_some())
 }
 
 /// What may make a steady tap's channels misleading, each with its kind (`period`, `double-tap`,
@@ -171,6 +186,9 @@ pub(crate) fn sweep_layout(sweep: &PeakForceSweep, frame: &Frame, taps: &[SweepT
     let modulus = channels.iter().position(|v| v.name == "modulus_dmt");
     let modulus = channels.remove(modulus.expect("a column"));
     variables.extend(channels.into_iter().chain([modulus]));
+    if with_noise(taps) {
+        variables.extend(columns::variables(&NOISE_COLUMNS, frame, taps, &d, &names));
+    }
     let period = taps
         .iter()
         .map(|t| t.tap.as_ref().map_or(0.0, |t| t.period as f64));

@@ -4,7 +4,7 @@
 //! distance and against time.
 
 use super::{lines, numeric_csv, tail, with_document, Destination, Files};
-use crate::analysis::peakforce::SteadyTap;
+use crate::analysis::peakforce::{SteadyTap, TapNoise};
 use crate::layout::columns::{self, columns, Column};
 use crate::layout::figure::{Series, Style};
 use crate::params::Params;
@@ -48,6 +48,15 @@ pub(crate) const COLUMNS: [Column<Frame, SweepTap>; 10] = columns! {
         Opt(|f, t| Some(t.params.rest_distance() * f.u.length));
 };
 
+/// The channels a sweep with a temperature adds after [`COLUMNS`]: the tap's thermal noise
+/// (`crate::analysis::peakforce::tap_noise`).
+pub(crate) const NOISE_COLUMNS: [Column<Frame, SweepTap>; 2] = columns! {
+    "peak_force_noise", Force, true, "peak force's thermal noise per cycle (σ)",
+        Opt(|f, t| Some(t.noise?.peak_force * f.u.force));
+    "deformation_noise", Length, true, "deformation's thermal noise per cycle (σ)",
+        Opt(|f, t| Some(t.noise?.deformation * f.u.length));
+};
+
 /// The names of a sweep's channels ([`COLUMNS`]), in the order of its table.
 pub(crate) fn channel_names() -> Vec<&'static str> {
     columns::names(&COLUMNS)
@@ -67,6 +76,8 @@ pub struct SweepTap {
     pub evaluations: usize,
     /// Why the point failed (`None` when it was computed).
     pub message: Option<String>,
+    /// The tap's thermal noise (with a temperature).
+    pub noise: Option<TapNoise>,
 }
 
 /// The columns of the cycle's table (`peakforce-cycle.csv`, Python's Dataset variables).
@@ -124,6 +135,9 @@ fn sweep_table(doc: &Value) -> Option<SweepTable> {
     }];
     let channels = channel_names();
     columns.extend(channels.into_iter().filter(|c| *c != param));
+    if block["channels"].get(NOISE_COLUMNS[0].name).is_some() {
+        columns.extend(columns::names(&NOISE_COLUMNS));
+    }
     let channels = rows(block, "channels", &columns[1..]);
     let table = values
         .iter()
