@@ -562,9 +562,15 @@ pub struct PeakForceFlags {
     /// `--samples`: the request's `samples`.
     #[arg(long, default_value = "4096", help = "Points of the reported cycle, in 2000..=1000000 (default 4096).")]
     pub samples: usize,
+    /// `--seed`: the request's `seed`.
+    #[arg(long, default_value = "0", help = "The seed of the thermal run's random stream (with --thermal-cycles; default 0): the run is a function of its seed.")]
+    pub seed: u64,
     /// `--temperature`: the request's `temperature`.
     #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: the standard deviations, from cycle to cycle, of the tap's peak force and deformation under the lever's thermal force, by linear response about the steady tap; a sweep gains them as the channels peak_force_noise and deformation_noise of every value (the block is the single-tap blocks' tap's). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) are refused.")]
     pub temperature: Option<f64>,
+    /// `--thermal-cycles`: the request's `thermal_cycles`.
+    #[arg(long, help = "Modulation cycles of a thermally driven run of the tap (with --temperature; 100..=1000000): the \"thermal\" block gains simulated, the per-cycle peak force's and deformation's σ (with standard errors) and quantiles measured on the lever itself (each cycle sampled at --samples points): what the linear response cannot give near a jump to contact. Not given (default): no run.")]
+    pub thermal_cycles: Option<usize>,
 }
 
 impl PeakForceFlags {
@@ -576,9 +582,11 @@ impl PeakForceFlags {
         Ok(PeakForceRequest {
             filter_cutoff: quantity(self.filter_cutoff, "filter-cutoff", Dim::Frequency, si)?,
             samples: self.samples,
+            seed: self.seed,
             setpoint: quantity(self.setpoint, "setpoint", Dim::Force, si)?,
             sweep,
             temperature: self.temperature,
+            thermal_cycles: self.thermal_cycles,
             ..PeakForceRequest::default()
         })
     }

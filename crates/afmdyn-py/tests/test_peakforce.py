@@ -34,12 +34,15 @@ def test_peakforce_equals_the_command_line(cli_json, tmp_path):
 def test_peakforce_temperature_equals_the_command_line(cli_json, tmp_path):
     # the thermal block's σ (the library's linear response, tested there against a simulated
     # lever and equipartition) reaches the dataset's attributes as the command line's
+    # (and a thermally driven run, a function of its seed on every front end)
     doc = cli_json(
-        "peakforce", "--probe", AIR, "--z-c", "97nm", "--temperature", "295", "--files", "none"
+        "peakforce", "--probe", AIR, "--z-c", "97nm", "--temperature", "295",
+        "--thermal-cycles", "100", "--seed", "3", "--files", "none"
     )
-    ds = afmdyn.peakforce(probe=AIR, z_c=97e-9, temperature=295.0)
+    ds = afmdyn.peakforce(probe=AIR, z_c=97e-9, temperature=295.0, thermal_cycles=100, seed=3)
     thermal = json.loads(ds.attrs["summary"])["thermal"]
     assert thermal == doc["thermal"]
+    assert thermal["simulated"]["cycles"] == 100 and thermal["simulated"]["seed"] == 3
     assert ds.attrs["peak_force_noise"] == doc["thermal"]["peak_force_noise"] > 0
     assert ds.attrs["deformation_noise"] == doc["thermal"]["deformation_noise"] > 0
     assert "peak_force_noise" not in afmdyn.peakforce(probe=AIR, z_c=97e-9).attrs

@@ -147,7 +147,7 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("peakforce", ["--probe", PF]),
     # the thermal block, and the noise channels of a sweep
     ("peakforce", ["--probe", PF, "--temperature", 295, "--from", "90nm", "--to", "89nm",
-                   "--step", "1nm", "--files", "none"]),
+                   "--step", "1nm", "--thermal-cycles", 100, "--files", "none"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus,contact_point",
              "--files", "data"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus",

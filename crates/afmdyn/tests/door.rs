@@ -381,8 +381,9 @@ fn case(name: &str) -> Option<Case> {
         "peakforce" => Case {
             probe: Some(PEAKFORCE),
             sizes: [
-                // with the thermal block's walk over the tap (its declared work)
-                json!({"samples": 2048, "temperature": 295.0}),
+                // with the thermal block's walk over the tap and a thermally driven run of it
+                // (their declared work)
+                json!({"samples": 2048, "temperature": 295.0, "thermal_cycles": 100}),
                 // a sweep keeps one cycle, not one per value (20 × 8192 samples grew past its
                 // declaration)
                 json!({"samples": 8192, "sweep": {"quantity": "z_c",

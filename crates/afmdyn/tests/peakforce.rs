@@ -658,7 +658,9 @@ fn a_modulation_too_slow_for_the_integrator_is_refused_by_its_key() {
 /// rests in contact for tens of its relaxation times Q/(πf₀): at the top of the modulation its
 /// deviation is the contact oscillator's stationary one, whose noise and damping are the
 /// lever's, so ⟨δx²⟩ = k_BT/(k + k_s) (the fluctuation–dissipation theorem; Callen & Welton
-/// 1951) and σ_F = k_s σ_x, within 1 %. σ scales as √T (linear response); a sweep carries each
+/// 1951) and σ_F = k_s σ_x, within 1 %, at the peak's time; the per-cycle maxima of a thermally
+/// driven run, each the largest of many fluctuations over the flat peak, spread less (said by
+/// `thermal.flat-peak`). σ scales as √T (linear response); a sweep carries each
 /// value's noise; the laws with memory, a temperature without a probe and one out of range are
 /// refused naming it.
 #[test]
@@ -690,6 +692,21 @@ fn a_temperature_gives_the_taps_thermal_noise() {
     assert!((deformation / sigma_x - 1.0).abs() < 0.01, "{th}");
     assert!((force / (ks * sigma_x) - 1.0).abs() < 0.01, "{th}");
     assert_eq!(th["units"]["peak_force_noise"], "N");
+    // pressed this slowly the peak is flat against the noise: each cycle's maximum is the
+    // largest of many fluctuations, said, and narrower in spread (a thermally driven run)
+    let said = doc["warnings"].to_string();
+    assert!(said.contains("the tap's peak is flat"), "{said}");
+    let sim = named::parse(
+        "peakforce",
+        serde_json::json!({"temperature": 295.0, "thermal_cycles": 100}),
+    )
+    .unwrap()
+    .unwrap();
+    let sim = sim.run(&model, &Default::default()).unwrap().document;
+    let maxima = sim["thermal"]["simulated"]["deformation_noise"]
+        .as_f64()
+        .unwrap();
+    assert!(maxima < 0.8 * deformation, "{maxima} vs {deformation}");
     let hot = run(4.0 * 295.0)["thermal"]["peak_force_noise"]
         .as_f64()
         .unwrap();
@@ -723,6 +740,13 @@ fn a_temperature_gives_the_taps_thermal_noise() {
     };
     let e = refused(serde_json::json!({"temperature": -3.0}), &model);
     assert!(e.contains("temperature"), "{e}");
+    for cycles in [
+        serde_json::json!({"thermal_cycles": 200}),
+        serde_json::json!({"temperature": 295.0, "thermal_cycles": 10}),
+    ] {
+        let e = refused(cycles, &model);
+        assert!(e.contains("thermal_cycles"), "{e}");
+    }
     let plain = Resolved::plain(point_mass(ContactLaw::Hertz, 10.0, 20.0, 20.0, 0.9));
     let e = refused(serde_json::json!({"temperature": 295.0}), &plain);
     assert!(e.contains("temperature") && e.contains("probe"), "{e}");

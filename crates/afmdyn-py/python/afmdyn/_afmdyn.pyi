@@ -426,9 +426,11 @@ PeakForceRequest = TypedDict(
         "filter_cutoff": Optional[float],  # default null
         "fit_band": List[float],  # default [0.3, 0.9]
         "samples": int,  # default 4096
+        "seed": int,  # default 0
         "setpoint": Optional[float],  # default null
         "sweep": Optional[PeakForceSweep],  # default null
         "temperature": Optional[float],  # default null
+        "thermal_cycles": Optional[int],  # default null
         "z_c": Optional[float],  # default null
     },
     total=False,

@@ -801,8 +801,10 @@ def peakforce(
     filter_cutoff: Optional[float] = None,
     fit_band: Optional[Sequence[float]] = None,
     samples: int = 4096,
+    seed: int = 0,
     setpoint: Optional[float] = None,
     temperature: Optional[float] = None,
+    thermal_cycles: Optional[int] = None,
     z_c: Union[float, Sequence[float], None] = None,
     modulation_frequency: Optional[Sequence[float]] = None,
     progress: ProgressArg = None,
@@ -823,6 +825,8 @@ def peakforce(
         fit_band: The DMT fit's band: fractions [lo, hi] of the retract curve's force range
             from the adhesion to the peak force (default [0.3, 0.9]).
         samples: Points of the reported cycle, in 2000..=1000000 (default 4096).
+        seed: The seed of the thermal run's random stream (with ``thermal_cycles``; default
+            0): the run is a function of its seed.
         setpoint: The peak force the ideal feedback holds (N with a probe, else F̃), > 0:
             z_c is found so that the steady tap's peak force equals it. Excludes ``z_c``.
         temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
@@ -833,6 +837,13 @@ def peakforce(
             sweep gains them as the channels ``peak_force_noise`` and ``deformation_noise``
             of every value (the block is the single-tap blocks' tap's). Needs the probe's SI
             units; the laws with memory (JKR, capillary, SLS, impact) are refused.
+        thermal_cycles: Modulation cycles of a thermally driven run of the tap (with
+            ``temperature``; 100..=1000000): the ``"thermal"`` block gains ``simulated``,
+            the per-cycle peak force's and deformation's σ (with standard errors) and
+            quantiles measured on the lever itself
+            (``analysis::peakforce::simulated_tap_noise``, each cycle sampled at ``samples``
+            points): what the linear response cannot give near a jump to contact. ``None``
+            (default): no run.
         z_c: The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance
             with the lever at rest and the sample at the centre of its modulation; default
             the model's (the probe's ``[sample] z_c``, default A_m). Excludes ``setpoint``.

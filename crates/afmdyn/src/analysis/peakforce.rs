@@ -41,7 +41,9 @@ mod setpoint;
 pub use filter::low_pass_periodic;
 pub(crate) use fit::MIN_FIT_POINTS;
 pub use fit::{fit_dmt, DmtFit, FIT_BAND};
-pub use noise::{tap_noise, TapNoise};
+pub use noise::{
+    simulated_tap_noise, tap_noise, SimulatedTapNoise, TapNoise, MAX_PEAK_SHIFT, MIN_THERMAL_CYCLES,
+};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,
     SETPOINT_TOL,

@@ -8,7 +8,9 @@
 use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES, NOISE_PERIODS};
 use super::limits::Cost;
 use super::run::Resolved;
-use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, FIT_BAND, SETPOINT_ITERATIONS};
+use crate::analysis::peakforce::{
+    PeakForceOptions, BRACKET_STEPS, FIT_BAND, MIN_THERMAL_CYCLES, SETPOINT_ITERATIONS,
+};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -27,6 +29,15 @@ pub(crate) fn first_natural_frequency(p: &Params) -> f64 {
         crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
     })
 }
+
+/// The work of a thermally driven run per point of its cycles and mode, in mode-periods (0.8–3
+/// µs): measured 0.22 µs on examples/probe-peakforce-amo-garcia.toml (one mode), 1.2 µs on
+/// examples/probe-peakforce-air.toml and 2.7 µs on examples/probe-peakforce-water.toml (three
+/// modes, a point each).
+const SAMPLE_WORK: f64 = 1.0;
+
+/// Most modulation cycles of a thermally driven run ([`PeakForceRequest::thermal_cycles`]).
+pub(crate) const MAX_THERMAL_CYCLES: usize = 1_000_000;
 
 /// The thermal block's parts against the free lever's 512 per lever period (the contact's are
 /// shorter): 1.7 measured on examples/probe-peakforce-air.toml at z_c = 97 nm (30 109 parts
@@ -76,6 +87,18 @@ request! {
         /// capillary, SLS, impact) are refused.
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
+        /// Modulation cycles of a thermally driven run of the tap (with `temperature`;
+        /// 100..=1000000): the `"thermal"` block gains `simulated`, the per-cycle peak force's
+        /// and deformation's σ (with standard errors) and quantiles measured on the lever itself
+        /// ([`crate::analysis::peakforce::simulated_tap_noise`], each cycle sampled at
+        /// `samples` points): what the linear response cannot give near a jump to contact.
+        /// `None` (default): no run.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub thermal_cycles: Option<usize>,
+        /// The seed of the thermal run's random stream (with `thermal_cycles`; default 0): the
+        /// run is a function of its seed.
+        #[cfg_attr(feature = "schema", schemars(extend("default" = 0)))]
+        pub seed: u64 = 0,
     }
 }
 
@@ -179,6 +202,13 @@ impl PeakForceRequest {
     /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe);
     /// [`SimError::Unsupported`] for a law with memory.
     pub(crate) fn thermal(&self, model: &Resolved) -> Result<Option<f64>, SimError> {
+        if let Some(n) = self.thermal_cycles {
+            let why = "must be 100..=1000000 modulation cycles, with a temperature";
+            if self.temperature.is_none() || !(MIN_THERMAL_CYCLES..=MAX_THERMAL_CYCLES).contains(&n)
+            {
+                return Err(SimError::out_of_range("thermal_cycles", n, why));
+            }
+        }
         let Some(t) = self.temperature else {
             return Ok(None);
         };
@@ -342,6 +372,11 @@ impl_request! {
                 * p.modes as f64,
             None => 0.0,
         };
+        // the thermally driven run: its cycles and burn-in (a tenth), `samples` points each,
+        // a point SAMPLE_WORK per mode
+        let simulated = r.thermal_cycles.map_or(0.0, |n| {
+            1.1 * n as f64 * r.samples as f64 * SAMPLE_WORK * p.modes as f64
+        });
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
         // fits, multipliers and state, and the value's model
         let record = 2048.0 + 8.0 * state_bytes(&p) + std::mem::size_of::<Params>() as f64;
@@ -355,7 +390,7 @@ impl_request! {
                 + 64.0 * state_bytes(&p)
                 + points.len() as f64 * record,
             // and the reported cycle's samples, each under a mode-period (1.3 µs measured)
-            work: taps * tap + r.samples as f64 + noise,
+            work: taps * tap + r.samples as f64 + noise + simulated,
         })
     };
     computed_at |r, model| r.params(model)

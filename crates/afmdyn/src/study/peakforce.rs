@@ -17,11 +17,13 @@
 use super::peakforce_sweep::SweepTap;
 use super::Chain;
 use crate::analysis::peakforce::{
-    low_pass_periodic, peak_force_setpoint, static_compliance, steady_tap, steady_tap_from,
-    tap_noise, Cycle, PeakForceOptions, SetpointOptions, SteadyTap, TapNoise,
+    low_pass_periodic, peak_force_setpoint, simulated_tap_noise, static_compliance, steady_tap,
+    steady_tap_from, tap_noise, Cycle, PeakForceOptions, SetpointOptions, SimulatedTapNoise,
+    SteadyTap, TapNoise, MAX_PEAK_SHIFT,
 };
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::integrate::exact::ThermalForce;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::{Convergence, CurveUnits};
@@ -163,11 +165,20 @@ impl Analysis for PeakForceRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
         let mut r = self.tap(model, progress)?;
+        let Some(kt) = self.thermal(model)? else {
+            return Ok(r);
+        };
+        let m = CantileverModel::new(&tap_params(model, &r))?;
+        let (state, period) = (&r.tap.state, r.tap.period);
         // a sweep's taps carry their own (the first computed one's is the block's)
-        if let (Some(kt), None) = (self.thermal(model)?, &r.sweep) {
-            let m = CantileverModel::new(&tap_params(model, &r))?;
+        if r.sweep.is_none() {
             let integrator = self.options().integrator;
-            r.noise = Some(tap_noise(&m, &r.tap.state, r.tap.period, kt, integrator)?);
+            r.noise = Some(tap_noise(&m, state, period, kt, integrator)?);
+        }
+        if let Some(cycles) = self.thermal_cycles {
+            let force = ThermalForce::new(kt, self.seed);
+            let run = simulated_tap_noise(&m, state, period, force, cycles, self.samples)?;
+            r.simulated = Some(run);
         }
         Ok(r)
     }
@@ -237,6 +248,7 @@ fn execute_sweep(
         filtered: request.filtered(model, &first.params, &tap)?,
         evaluations: taps.iter().map(|t| t.evaluations).sum(),
         noise: first.noise,
+        simulated: None,
         tap,
         sweep: Some(taps),
     })
@@ -258,6 +270,8 @@ pub struct PeakForceResult {
     pub sweep: Option<Vec<SweepTap>>,
     /// The tap's thermal noise (with [`PeakForceRequest::temperature`]).
     pub noise: Option<TapNoise>,
+    /// The thermally driven run of the tap (with [`PeakForceRequest::thermal_cycles`]).
+    pub simulated: Option<SimulatedTapNoise>,
 }
 
 /// The filter's words in the document (`filter.kind`).
@@ -507,21 +521,46 @@ fn thermal_block(
              make or break contact, which no linearisation holds)"
         ));
     }
-    if taps.iter().any(|(n, _)| n.snap_in) {
+    if taps.iter().any(|(n, _)| n.flat_peak) {
+        warnings.push(warning!(
+            "thermal.flat-peak",
+            "Read peak_force_noise and deformation_noise as the channels' σ at the peak's time; \
+             a thermally driven run (thermal_cycles) measures the per-cycle maxima.",
+            "the tap's peak is flat against the thermal noise (the noise's slope shifts the \
+             per-cycle maximum by more than {MAX_PEAK_SHIFT} of its σ): each cycle's peak is \
+             then the largest of several fluctuations, narrower in spread and higher than the \
+             linear response's σ at the peak's time"
+        ));
+    }
+    if r.simulated.is_none() && taps.iter().any(|(n, _)| n.snap_in) {
         warnings.push(warning!(
             "thermal.snap-in",
             "Read the σ as the typical cycle's spread; a thermally driven run of the tap \
-             (simulate --temperature) shows the rare hard taps.",
+             (thermal_cycles, --thermal-cycles) measures the rare hard taps.",
             "the tap jumps to contact (out of contact the attraction's stiffness passes the \
              lever's): the noise moves the jump nonlinearly, so the linear response gives the \
              Gaussian core of the peaks' spread, not its tail of rare hard taps (8× the variance \
              in a simulated tap on polystyrene, crate::analysis::peakforce::tap_noise)"
         ));
     }
+    let simulated = r.simulated.as_ref().map(|s| {
+        let scaled = |v: &[f64], k: f64| v.iter().map(|x| x * k).collect::<Vec<_>>();
+        json!({
+            "cycles": s.cycles,
+            "seed": s.seed,
+            "peak_force_noise": s.peak_force[0] * u.force,
+            "peak_force_noise_error": s.peak_force[1] * u.force,
+            "deformation_noise": s.deformation[0] * u.length,
+            "deformation_noise_error": s.deformation[1] * u.length,
+            "peak_force_quantiles": scaled(&s.peak_force_quantiles, u.force),
+            "deformation_quantiles": scaled(&s.deformation_quantiles, u.length),
+        })
+    });
     Some(json!({
         "temperature": t,
         "peak_force_noise": n.peak_force * u.force,
         "deformation_noise": n.deformation * u.length,
+        "simulated": simulated,
         "units": if u.si { json!({"temperature": "K", "peak_force_noise": "N", "deformation_noise": "m"}) } else { json!({"temperature": "K", "peak_force_noise": "F", "deformation_noise": "g0"}) },
         "method": "standard deviations from cycle to cycle of the peak force and the deformation under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
     }))
@@ -735,6 +774,7 @@ impl PeakForceRequest {
                     evaluations: s.evaluations,
                     sweep: None,
                     noise: None,
+                    simulated: None,
                 })
             }
             None => {
@@ -746,6 +786,7 @@ impl PeakForceRequest {
                     evaluations: 1,
                     sweep: None,
                     noise: None,
+                    simulated: None,
                 })
             }
         }

@@ -259,6 +259,22 @@ fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Optio
             value(num(&th["peak_force_noise"]), "N", "F"),
             value(num(&th["deformation_noise"]), "m", "g0"),
         ));
+        let sim = &th["simulated"];
+        if sim.is_object() {
+            let q = |k: &str, i: usize| num(&sim[k][i]);
+            p.line(format!(
+                "  simulated over {} cycles (seed {}): σ(peak force) = {} ± {}, 1–99 % {} to {}; \
+                 σ(deformation) = {} ± {}",
+                sim["cycles"],
+                sim["seed"],
+                value(num(&sim["peak_force_noise"]), "N", "F"),
+                value(num(&sim["peak_force_noise_error"]), "N", "F"),
+                value(q("peak_force_quantiles", 0), "N", "F"),
+                value(q("peak_force_quantiles", 2), "N", "F"),
+                value(num(&sim["deformation_noise"]), "m", "g0"),
+                value(num(&sim["deformation_noise_error"]), "m", "g0"),
+            ));
+        }
     }
     let o = &document["orbit"];
     p.line(format!(

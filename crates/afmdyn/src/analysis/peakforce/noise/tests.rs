@@ -1,14 +1,12 @@
 //! The tap's linear-response noise against the thermally driven tapping lever itself (the
 //! stochastic step of `crate::integrate::exact::noise`: exact over a linear sample,
-//! exponential Euler over a DMT one): the per-cycle peak force and deformation of a simulated
-//! run, each the largest over the cycle's grid points near the peak.
+//! exponential Euler over a DMT one, [`simulated_tap_noise`]): the per-cycle peak force and
+//! deformation of a simulated run, each the largest over the cycle's grid points.
 
 use super::*;
-use crate::analysis::lock_in_noise::tests::agrees_by_batch_means;
 use crate::analysis::peakforce::{steady_tap, PeakForceOptions};
 use crate::analysis::thermal::BOLTZMANN;
-use crate::integrate::exact::{ThermalExact, ThermalForce};
-use crate::integrate::{advance, Integrator};
+use crate::integrate::exact::ThermalForce;
 use crate::probe::Probe;
 
 /// A point-mass lever of `k` (N/m; 70 kHz, Q = 20) over `sample` (a `[sample]` table's lines),
@@ -26,10 +24,10 @@ fn probe(k: f64, sample: &str) -> Probe {
 /// Over a linear sample (2 N/m, 10 nm past the tip's rest) and over polystyrene (DMT, 2 nm past,
 /// H = 10⁻²¹ J: the 2 N/m lever does not jump to contact, [`TapNoise::snap_in`]),
 /// the chain's σ of the peak force and the deformation against the simulated lever's per-cycle
-/// values over 6 000 cycles after a burn-in, at 295 K: within 4 standard errors of the simulated
-/// variance (batch means over 30 batches). σ_F is 2–5 % of the peak force, where the linear
-/// response holds; the grid's 4 096 points per cycle (410 per lever period) resolve the
-/// peak within 10⁻⁴ of the force's range.
+/// values over 3 000 cycles after a burn-in, at 295 K: within 4 standard errors of the simulated
+/// σ (batch means over 20 batches). σ_F is 2–5 % of the peak force, where the linear response
+/// holds; the grid's 2 048 points per cycle (205 per lever period) resolve the peak within
+/// 10⁻³ of the contact's oscillation.
 #[test]
 fn the_simulated_tap_agrees() {
     for (name, k, sample) in [
@@ -82,44 +80,21 @@ fn tap_agrees(name: &str, probe: &Probe) {
     assert_eq!(tap.period, 1, "{name}: a period-1 tap");
     let noise = tap_noise(&model, &tap.state, 1, kt, IntegratorOptions::default()).unwrap();
     assert!(!noise.snap_in, "{name}: no jump to contact");
-    // the peak's time on the orbit, τ = T/4 + t
-    let c = &tap.cycle;
-    let k = (0..c.force.len())
-        .max_by(|&i, &j| c.force[i].total_cmp(&c.force[j]))
-        .unwrap();
-    let period = model.period();
-    let t_peak = super::super::time_origin(&model) + c.time[k];
-    let grid = 4096;
-    let opts = IntegratorOptions {
-        steps_per_period: grid,
-        ..IntegratorOptions::default()
-    };
-    let mut it = ThermalExact::new(&model, &opts, ThermalForce::new(kt, 5)).unwrap();
-    it.reset(0.0, &tap.state).unwrap();
-    let (burn, batches, per) = (100, 30, 200);
-    // the grid points within ±T/20 of the peak (the contact's ±1/2 lever period)
-    let (first, last) = (
-        ((t_peak / period - 0.05) * grid as f64).floor() as i64,
-        ((t_peak / period + 0.05) * grid as f64).ceil() as i64,
-    );
-    let mut series = [Vec::new(), Vec::new()];
-    for cycle in 0..burn + batches * per {
-        let (mut force, mut depth) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        for j in first..=last {
-            let tau = period * (cycle as f64 + j as f64 / grid as f64);
-            advance(&mut it, tau).unwrap();
-            let z = it.state();
-            force = force.max(model.contact_force(model.region_at(tau, z), tau, z));
-            depth = depth.max(-model.v_t(tau, z));
-        }
-        if cycle >= burn {
-            series[0].push(force);
-            series[1].push(depth);
-        }
+    assert!(!noise.flat_peak, "{name}: a sharp peak");
+    let force = ThermalForce::new(kt, 5);
+    let run = simulated_tap_noise(&model, &tap.state, 1, force, 3000, 2048).unwrap();
+    for (what, [sigma, se], predicted) in [
+        ("peak force", run.peak_force, noise.peak_force),
+        ("deformation", run.deformation, noise.deformation),
+    ] {
+        println!(
+            "{name}, {what}: simulated σ {sigma:.4e} ± {se:.2e}, linear response {predicted:.4e}"
+        );
+        assert!(
+            (sigma - predicted).abs() < 4.0 * se,
+            "{name} {what}: {sigma} ± {se} vs {predicted}"
+        );
     }
-    let predicted = [noise.peak_force.powi(2), noise.deformation.powi(2)];
-    let names = ["peak force", "deformation"];
-    agrees_by_batch_means(name, &names, &series, per, &predicted);
     println!(
         "{name}: peak force {:.4e}, σ_F {:.3e} (F̃); deformation {:.4e}, σ {:.3e} (g₀)",
         tap.channels.peak_force, noise.peak_force, tap.channels.deformation, noise.deformation
