@@ -832,11 +832,13 @@ def peakforce(
         temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
             200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
             the document gains a ``"thermal"`` block: the standard deviations, from cycle to
-            cycle, of the tap's peak force and deformation under the lever's thermal force,
-            by linear response about the steady tap (``analysis::peakforce::tap_noise``); a
-            sweep gains them as the channels ``peak_force_noise`` and ``deformation_noise``
-            of every value (the block is the single-tap blocks' tap's). Needs the probe's SI
-            units; the laws with memory (JKR, capillary, SLS, impact) are refused.
+            cycle, of the tap's force and deformation at their peaks' times under the
+            lever's thermal force, by linear response about the steady tap
+            (``analysis::peakforce::tap_noise``; the per-cycle maxima's where the peak is
+            sharp); a sweep gains them as the channels ``peak_force_noise`` and
+            ``deformation_noise`` of every value (the block is the single-tap blocks'
+            tap's). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS,
+            impact) are refused.
         thermal_cycles: Modulation cycles of a thermally driven run of the tap (with
             ``temperature``; 100..=1000000): the ``"thermal"`` block gains ``simulated``,
             the per-cycle peak force's and deformation's σ (with standard errors) and

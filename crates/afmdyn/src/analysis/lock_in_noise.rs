@@ -2,13 +2,13 @@
 //! linear response: what an AM-AFM at that operating point measures as σ_A and σ_φ at the
 //! lock-in's bandwidth.
 //!
-//! **The chain** ([`super::orbit_noise`]): the deviation δz from the period-1 orbit, extended by
+//! **The chain** (`crate::analysis::orbit_noise`): the deviation δz from the period-1 orbit, extended by
 //! the lock-in's states. The lock-in of [`super::am_loop`] is linear in W(1,τ): over a drive
 //! period it sums X = (2/M) Σ_j W_j sin θ_j and Y = −(2/M) Σ_j W_j cos θ_j at M equal parts,
 //! then low-passes them once per period, X̄ ← X̄ + β(X − X̄), β = 1 − e^{−T/τ_L}. The deviation
 //! y = (δz, δX, δY, δX̄, δȲ) of the whole chain is then a linear system in discrete time: over
 //! one period y ↦ F y + ξ, the orbit walked in M·[`SUBSTEPS`] equal parts (ΩT/(M·SUBSTEPS) =
-//! [`super::orbit_noise::ETA`] at resonance) and the lock-in's linear maps at its samples.
+//! `orbit_noise::ETA` at resonance) and the lock-in's linear maps at its samples.
 //! From the stationary covariance Y, σ_A² = gᵀYg, σ_φ² = hᵀYh with g = (X̄, Ȳ)/A and
 //! h = (−Ȳ, X̄)/A² on (δX̄, δȲ): the gradients of A = |(X̄, Ȳ)| and φ = arg(X̄ + iȲ) at the
 //! orbit's first harmonic.
@@ -66,7 +66,7 @@ impl LockInNoise {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `samples` (0), `kt` or `time_constant` (negative or not
-/// finite); [`SimError::Unsupported`] for a law with memory ([`admits_model`]); the integrator's and
+/// finite); [`SimError::Unsupported`] for a law with memory ([`crate::integrate::exact::noise::admits_model`]); the integrator's and
 /// the flow's errors; [`SimError::OutOfRange`] naming `drive` for a multifrequency drive.
 pub fn lock_in_noise(
     model: &CantileverModel,

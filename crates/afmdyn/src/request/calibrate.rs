@@ -126,12 +126,8 @@ impl_request! {
                 "a pair lo, hi per mode with 0 ≤ lo < hi (Hz)",
             );
         }
-        if let Some(s) = r.invols.filter(|s| !(s.is_finite() && *s > 0.0)) {
-            return refuse(
-                "invols",
-                crate::error::number(s),
-                "the InvOLS is finite and > 0 (m/V)",
-            );
+        if let Some(s) = r.invols {
+            super::limits::positive("invols", s, "the InvOLS is finite and > 0 (m/V)")?;
         }
         match (
             r.volts,

@@ -374,11 +374,9 @@ impl FitRequest {
         if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
             return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));
         }
-        if let Some(n) = self
-            .detector_noise
-            .filter(|n| !(n.is_finite() && *n >= 0.0))
-        {
-            return Err(bad("detector_noise", number(n), "finite and ≥ 0 (m/√Hz)"));
+        if let Some(n) = self.detector_noise {
+            let why = "finite and ≥ 0 (m/√Hz)";
+            crate::error::within("detector_noise", n, 0.0..f64::INFINITY, why)?;
         }
         match model.probe.as_ref().map(|p| &p.assumed) {
             Some(a) if a.iter().any(|k| k.starts_with("[cantilever]")) => Err(bad(

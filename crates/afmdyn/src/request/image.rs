@@ -21,6 +21,7 @@ use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
+use std::ops::Bound::Excluded;
 
 use super::costs::{image_curves_cost, MODEL_BYTES};
 use super::limits::Cost;
@@ -150,13 +151,13 @@ impl ImageRequest {
     /// [`SimError::OutOfRange`] naming `setpoint` (in (0, 1)), `pixels`, `lines` (1..=4096;
     /// 1 for a line map) or `curve_points` (8..=2000).
     pub fn validate(&self, map: &SampleMap) -> Result<(), SimError> {
-        if !(self.setpoint > 0.0 && self.setpoint < 1.0) {
-            return Err(SimError::out_of_range(
-                "setpoint",
-                crate::error::number(self.setpoint),
-                "must be a ratio A_sp/A0 in (0, 1)",
-            ));
-        }
+        let why = "must be a ratio A_sp/A0 in (0, 1)";
+        crate::error::within(
+            "setpoint",
+            self.setpoint,
+            (Excluded(0.0), Excluded(1.0)),
+            why,
+        )?;
         self.validate_grid(map)
     }
 

@@ -188,3 +188,16 @@ pub(crate) fn thermal_force(
     let kt = crate::analysis::thermal::BOLTZMANN * t / probe.scales.energy_j();
     Ok(crate::integrate::exact::ThermalForce::new(kt, seed))
 }
+
+/// k_B T at `t` in the model's energy unit of `model`'s probe, for a linear-response noise
+/// estimate of its law and drive ([`thermal_force`]'s checks, then
+/// [`crate::integrate::exact::noise::admits_model`]'s).
+///
+/// # Errors
+/// As [`thermal_force`]; [`crate::SimError::Unsupported`] for a law with memory,
+/// [`crate::SimError::OutOfRange`] naming `drive` for a multifrequency drive.
+pub(crate) fn thermal_kt(t: f64, model: &super::Resolved) -> Result<f64, crate::SimError> {
+    let kt = thermal_force(t, 0, model.probe.as_ref())?.kt;
+    crate::integrate::exact::noise::admits_model(&model.params)?;
+    Ok(kt)
+}

@@ -330,13 +330,12 @@ impl ApproachRequest {
     /// As [`approach_request`].
     pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
         if let Some(s) = self.setpoint {
-            if !(s.is_finite() && s > 0.0 && s <= 1.0) {
-                return Err(SimError::out_of_range(
-                    "setpoint",
-                    s,
-                    "must be in (0, 1]: the amplitude setpoint A_sp/A0",
-                ));
-            }
+            let (open, one) = (
+                std::ops::Bound::Excluded(0.0),
+                std::ops::Bound::Included(1.0),
+            );
+            let why = "must be in (0, 1]: the amplitude setpoint A_sp/A0";
+            crate::error::within("setpoint", s, (open, one), why)?;
         }
         let average = self.average || model.params.is_quasiperiodic();
         let mut spec = approach_request(
@@ -367,8 +366,7 @@ impl ApproachRequest {
                 |tc| SimError::out_of_range("time_constant", crate::error::number(tc), why);
             return self.time_constant.map_or(Ok(None), |tc| Err(refuse(tc)));
         };
-        let kt = super::limits::thermal_force(t, 0, model.probe.as_ref())?.kt;
-        crate::integrate::exact::noise::admits_model(&model.params)?;
+        let kt = super::limits::thermal_kt(t, model)?;
         let probe = model.probe.as_ref().expect("thermal_force checked it");
         let tc = super::image_scan::lock_in_time_constant(probe, self.time_constant)?;
         Ok(Some(ThermalLockIn {

@@ -100,13 +100,12 @@ impl SimulateRequest {
         bytes_per_value: f64,
     ) -> Result<SimulateSpan, SimError> {
         check_samples_per_period(self.samples_per_period)?;
-        if !(self.transient.is_finite() && self.transient >= 0.0) {
-            return Err(SimError::out_of_range(
-                "transient",
-                self.transient,
-                "must be finite and >= 0",
-            ));
-        }
+        crate::error::within(
+            "transient",
+            self.transient,
+            0.0..f64::INFINITY,
+            "must be finite and >= 0",
+        )?;
         let period = params.period();
         let transient_tau = self.transient * period;
         let record_tau = match (self.periods, self.tau_end) {

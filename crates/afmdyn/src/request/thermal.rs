@@ -61,12 +61,8 @@ impl_request! {
     ThermalRequest, "thermal", advice = "ask for fewer points";
     validate |r, model| {
         check_thermal(model, r.temperature, r.spot)?;
-        if let Some(f) = r.to.filter(|f| !(f.is_finite() && *f > 0.0)) {
-            return Err(SimError::out_of_range(
-                "to",
-                crate::error::number(f),
-                "the highest frequency must be finite and > 0 (Hz)",
-            ));
+        if let Some(f) = r.to {
+            super::limits::positive("to", f, "the highest frequency must be finite and > 0 (Hz)")?;
         }
         crate::error::within(
             "points",

@@ -562,7 +562,7 @@ fn thermal_block(
         "deformation_noise": n.deformation * u.length,
         "simulated": simulated,
         "units": if u.si { json!({"temperature": "K", "peak_force_noise": "N", "deformation_noise": "m"}) } else { json!({"temperature": "K", "peak_force_noise": "F", "deformation_noise": "g0"}) },
-        "method": "standard deviations from cycle to cycle of the peak force and the deformation under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
+        "method": "standard deviations from cycle to cycle of the force and the deformation at their peaks' times (the per-cycle maxima's where the peak is sharp: thermal.flat-peak) under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
     }))
 }
 

@@ -1,6 +1,6 @@
-//! A PeakForce tap's thermal noise: the standard deviations, from cycle to cycle, of its peak
-//! force and its deformation under the lever's thermal force, by linear response about the
-//! steady tap ([`crate::analysis::orbit_noise`]: the deviations' chain over the orbit's n
+//! A PeakForce tap's thermal noise: the standard deviations, from cycle to cycle, of its force
+//! and its deformation at their peaks' times under the lever's thermal force, by linear
+//! response about the steady tap ([`crate::analysis::orbit_noise`]: the deviations' chain over the orbit's n
 //! modulation periods, its stationary covariance, and the covariance Σ(t) at the time t of the
 //! channel's extremum).
 //!
@@ -13,7 +13,7 @@
 //!
 //! **Validity.** This is the channel's σ at the peak's time, which is the per-cycle maximum's
 //! while the peak is sharp against the noise. Near a flat peak the noise's own slope ṅ moves
-//! the maximum: M ≈ F(t_p) + n(t_p) + ṅ(t_p)²/(2|F''|), a mean shift E[ṅ²]/(2|F''|) (ṅ the
+//! the maximum: M ≈ F(t_p) + n(t_p) + ṅ(t_p)²/(2|F''|), a mean shift E\[ṅ²\]/(2|F''|) (ṅ the
 //! elastic part of the channel's rate, ∂F_c/∂δ δ̇; F'' the orbit's curvature at the peak, by
 //! the three parts about it). Where that shift passes [`MAX_PEAK_SHIFT`] σ
 //! ([`TapNoise::flat_peak`]) each cycle's peak is the largest of several fluctuations, higher
@@ -124,7 +124,7 @@ impl Extremum {
 }
 
 /// The largest mean shift of a channel's per-cycle maximum by the noise's slope,
-/// E[ṅ²]/(2|F''|), against its σ, for the linear response to be the maximum's (module docs):
+/// E\[ṅ²\]/(2|F''|), against its σ, for the linear response to be the maximum's (module docs):
 /// measured up to 0.35 within 5 % of the simulated maxima's σ, at 42 twice it.
 pub const MAX_PEAK_SHIFT: f64 = 1.0;
 
@@ -199,7 +199,7 @@ pub fn tap_noise(
 /// error of its variance ([`simulated_tap_noise`]).
 const BATCHES: usize = 20;
 
-/// Fewest modulation cycles of a simulated run: its [`BATCHES`] batches of at least 5.
+/// Fewest modulation cycles of a simulated run: its `BATCHES` batches of at least 5.
 pub const MIN_THERMAL_CYCLES: usize = 100;
 
 /// The per-cycle peak force and deformation of a thermally driven run of the tap
@@ -229,7 +229,7 @@ pub struct SimulatedTapNoise {
 /// `samples` equally spaced points per modulation period (`periods` of them make the orbit's
 /// cycle), points of the step's grid.
 /// What the linear response ([`tap_noise`]) cannot give near a jump to contact: the tail.
-/// σ's standard error is the spread of [`BATCHES`] batch means of the squared deviations
+/// σ's standard error is the spread of 20 batch means of the squared deviations
 /// (batches much longer than the cycles' correlation).
 ///
 /// # Errors
