@@ -155,14 +155,10 @@ impl FmRequest {
             // the model's lengths are in units of its A₀ (g₀): an amplitude 1e8 times smaller
             // or 1e4 times larger leaves nothing of the other length scales
             let (lo, hi) = (FM_AMPLITUDE_RANGE.0 * length, FM_AMPLITUDE_RANGE.1 * length);
-            crate::error::within(
-                "amplitude",
-                a,
-                lo..=hi,
-                "must be within [1e-8, 1e4] × the model's length unit (A₀ of a probe's \
-                 [drive] free_amplitude): amplitudes are in m with a probe (100 pm is \
-                 100e-12, or 100pm on the command line)",
-            )?;
+            let why = "must be within [1e-8, 1e4] × the model's length unit (A₀ of a probe's \
+                       [drive] free_amplitude): amplitudes are in m with a probe (100 pm is \
+                       100e-12, or 100pm on the command line)";
+            crate::error::within("amplitude", a, lo..=hi, why)?;
         }
         if length != 1.0 {
             range.check_si_distances()?;

@@ -152,12 +152,8 @@ impl ImageRequest {
     /// 1 for a line map) or `curve_points` (8..=2000).
     pub fn validate(&self, map: &SampleMap) -> Result<(), SimError> {
         let why = "must be a ratio A_sp/A0 in (0, 1)";
-        crate::error::within(
-            "setpoint",
-            self.setpoint,
-            (Excluded(0.0), Excluded(1.0)),
-            why,
-        )?;
+        let open = (Excluded(0.0), Excluded(1.0));
+        crate::error::within("setpoint", self.setpoint, open, why)?;
         self.validate_grid(map)
     }
 

@@ -359,9 +359,8 @@ impl_request! {
         let noise = r.temperature.map_or(0.0, |_| noise);
         // the thermally driven run: its cycles and burn-in (a tenth), `samples` points each,
         // a point SAMPLE_WORK per mode
-        let simulated = r.thermal_cycles.map_or(0.0, |n| {
-            1.1 * n as f64 * r.samples as f64 * SAMPLE_WORK * p.modes as f64
-        });
+        let per_cycle = 1.1 * r.samples as f64 * SAMPLE_WORK * p.modes as f64;
+        let simulated = r.thermal_cycles.map_or(0.0, |n| n as f64 * per_cycle);
         // a sweep keeps every value's tap without its cycle (`study::peakforce`): the channels,
         // fits, multipliers and state, and the value's model
         let record = 2048.0 + 8.0 * state_bytes(&p) + std::mem::size_of::<Params>() as f64;

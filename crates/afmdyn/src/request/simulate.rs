@@ -100,12 +100,8 @@ impl SimulateRequest {
         bytes_per_value: f64,
     ) -> Result<SimulateSpan, SimError> {
         check_samples_per_period(self.samples_per_period)?;
-        crate::error::within(
-            "transient",
-            self.transient,
-            0.0..f64::INFINITY,
-            "must be finite and >= 0",
-        )?;
+        let (t, why) = (self.transient, "must be finite and >= 0");
+        crate::error::within("transient", t, 0.0..f64::INFINITY, why)?;
         let period = params.period();
         let transient_tau = self.transient * period;
         let record_tau = match (self.periods, self.tau_end) {
