@@ -27,11 +27,10 @@
 //! linearisation), and only for a stable orbit (an unstable one has no stationary covariance).
 //! Units are the model's: τ (eq. 5), lengths in g₀, k_B T in the model's energy unit.
 
+use crate::contact::ForceEval;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::noise::{
-    admits_model, contact_rate, diffusion, linear_part, van_loan,
-};
+use crate::integrate::exact::noise::{admits_model, diffusion, linear_part, rate_of, van_loan};
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::flow::{flow, FlowMap};
 use crate::model::CantileverModel;
@@ -96,7 +95,11 @@ pub(crate) struct Walk<'a> {
     /// D per region.
     d: [DMatrix<f64>; 2],
     /// The region at `tau`.
-    region: Region,
+    pub region: Region,
+    /// The law's tip force at `tau` (its value and partials).
+    pub force: ForceEval,
+    /// F's map of a part: the flow's Jacobian in its top-left block, the unit elsewhere.
+    map: DMatrix<f64>,
     /// The exact noise of the last part length of each region, (ℓ, Q).
     exact: [Option<(f64, DMatrix<f64>)>; 2],
     /// τ of the walk.
@@ -133,11 +136,14 @@ impl<'a> Walk<'a> {
         let linear = linear_part(model)?;
         let d = [Region::Free, Region::Contact].map(|r| diffusion(&linear, r, kt));
         let n = z.len() + observers;
+        let (region, force) = tip_force(model, 0.0, z);
         Ok(Walk {
             integ: build(model, options, 0.0, z)?,
             linear,
             d,
-            region: model.region_at(0.0, z),
+            region,
+            force,
+            map: DMatrix::identity(n, n),
             exact: [None, None],
             tau: 0.0,
             state: z.clone(),
@@ -155,19 +161,20 @@ impl<'a> Walk<'a> {
     /// The flow's.
     pub(crate) fn part(&mut self, t1: f64) -> Result<(), SimError> {
         let fl = self.flow(t1)?;
-        self.take(fl, t1);
+        let (to, force) = tip_force(self.model, t1, &fl.state);
+        self.take(fl, t1, to, force);
         Ok(())
     }
 
     /// A part toward `end` of at most `h` and of ω_c ℓ ≤ [`ETA`] at both its ends (ω_c the
-    /// contact's rate, [`contact_rate`]; halved until it holds, to ℓ ≥ 10⁻⁹ h): the parts of a
+    /// contact's rate, [`rate_of`]; halved until it holds, to ℓ ≥ 10⁻⁹ h): the parts of a
     /// walk whose times are free.
     ///
     /// # Errors
     /// The flow's.
     pub(crate) fn adaptive_part(&mut self, end: f64, h: f64) -> Result<(), SimError> {
-        let rate = |tau: f64, z: &DVector<f64>| contact_rate(self.model, tau, z);
-        let mut len = h.min(ETA / rate(self.tau, &self.state)).min(end - self.tau);
+        let m_eff = self.model.effective_mass();
+        let mut len = h.min(ETA / rate_of(&self.force, m_eff)).min(end - self.tau);
         loop {
             let t1 = if len >= end - self.tau {
                 end
@@ -175,8 +182,9 @@ impl<'a> Walk<'a> {
                 self.tau + len
             };
             let fl = self.flow(t1)?;
-            if len * rate(t1, &fl.state) <= ETA || len < 1e-9 * h {
-                self.take(fl, t1);
+            let (to, force) = tip_force(self.model, t1, &fl.state);
+            if len * rate_of(&force, m_eff) <= ETA || len < 1e-9 * h {
+                self.take(fl, t1, to, force);
                 return Ok(());
             }
             len *= 0.5;
@@ -194,36 +202,36 @@ impl<'a> Walk<'a> {
         law.is_affine() || (r == Region::Free && !law.acts_outside())
     }
 
-    /// The noise of the part to `t1` (module docs), the flow `fl` over it.
-    fn noise(&mut self, fl: &FlowMap, t1: f64, to: Region) -> DMatrix<f64> {
-        let h = t1 - self.tau;
-        let from = self.region;
-        if fl.switchings == 0 && from == to && self.linear_in(from) {
-            let i = from.index();
-            if let Some((l, q)) = &self.exact[i] {
-                if *l == h {
-                    return q.clone();
-                }
-            }
-            let a = &self.linear.dynamics(from).a;
-            let (_, q) = van_loan(a, &self.d[i], h);
-            self.exact[i] = Some((h, q.clone()));
-            return q;
-        }
-        let j = &fl.jacobian;
-        (j * &self.d[from.index()] * j.transpose() + &self.d[to.index()]) * (0.5 * h)
-    }
-
-    /// Take the part to `t1` of flow `fl`.
-    fn take(&mut self, fl: FlowMap, t1: f64) {
-        let to = self.model.region_at(t1, &fl.state);
-        let q = self.noise(&fl, t1, to);
-        let (n, dim) = (self.chain.f.nrows(), fl.state.len());
-        let mut m = DMatrix::identity(n, n);
-        m.view_mut((0, 0), (dim, dim)).copy_from(&fl.jacobian);
-        self.chain.apply(&m);
+    /// Take the part to `t1` of flow `fl`, ending in region `to` under the tip force `force`:
+    /// F ← M F, W ← M W Mᵀ + (the part's noise, module docs) on the deviation.
+    fn take(&mut self, fl: FlowMap, t1: f64, to: Region, force: ForceEval) {
+        let (h, from, dim) = (t1 - self.tau, self.region, fl.state.len());
+        let exact = fl.switchings == 0 && from == to && self.linear_in(from);
+        self.map
+            .view_mut((0, 0), (dim, dim))
+            .copy_from(&fl.jacobian);
+        self.chain.apply(&self.map);
         let mut top = self.chain.w.view_mut((0, 0), (dim, dim));
-        top += &q;
-        (self.state, self.tau, self.region) = (fl.state, t1, to);
+        if exact {
+            let i = from.index();
+            if !matches!(&self.exact[i], Some((l, _)) if *l == h) {
+                let (_, q) = van_loan(&self.linear.dynamics(from).a, &self.d[i], h);
+                self.exact[i] = Some((h, q));
+            }
+            top += &self.exact[i].as_ref().expect("set above").1;
+        } else {
+            let j = &fl.jacobian;
+            top += (j * &self.d[from.index()] * j.transpose() + &self.d[to.index()]) * (0.5 * h);
+        }
+        (self.state, self.tau, self.region, self.force) = (fl.state, t1, to, force);
     }
+}
+
+/// The region of (τ, `z`) on `model` and the law's tip force there.
+fn tip_force(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (Region, ForceEval) {
+    let r = model.region_at(tau, z);
+    (
+        r,
+        model.tip_force_eval(r, model.base_trig(tau), z.as_slice()),
+    )
 }

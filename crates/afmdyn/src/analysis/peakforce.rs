@@ -36,6 +36,8 @@
 mod filter;
 mod fit;
 mod noise;
+#[cfg(test)]
+pub(crate) use noise::batch_variance;
 mod setpoint;
 
 pub use filter::low_pass_periodic;
@@ -320,6 +322,12 @@ pub(crate) fn steady_tap_from(
         balance,
         cycle,
     })
+}
+
+/// The lever's first natural frequency as modelled (in its medium), in the units of Ω: 1 in
+/// the lumped models' units, ≈ 3.516 in the beam's.
+pub(crate) fn first_natural_frequency(model: &CantileverModel) -> f64 {
+    crate::eigen::natural_modes(model.galerkin().region(Region::Free)).omega[0]
 }
 
 /// τ of the largest separation, T/4 (Ωτ = π/2: the sinusoid α2 sin Ωτ at its top).

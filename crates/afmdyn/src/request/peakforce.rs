@@ -8,6 +8,7 @@
 use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES, NOISE_PERIODS};
 use super::limits::Cost;
 use super::run::Resolved;
+use crate::analysis::peakforce;
 use crate::analysis::peakforce::{
     PeakForceOptions, BRACKET_STEPS, FIT_BAND, MIN_THERMAL_CYCLES, SETPOINT_ITERATIONS,
 };
@@ -25,9 +26,7 @@ pub(crate) const MAX_MODULATION_RATIO: f64 = 0.5;
 /// The lever's first natural frequency as modelled, in the units of Ω (in its medium; 1 in the
 /// lumped models' units, ≈ 3.516 in the beam's): f₀/f_m = this / Ω.
 pub(crate) fn first_natural_frequency(p: &Params) -> f64 {
-    CantileverModel::new(p).map_or(1.0, |m| {
-        crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
-    })
+    CantileverModel::new(p).map_or(1.0, |m| peakforce::first_natural_frequency(&m))
 }
 
 /// The work of a thermally driven run per point of its cycles and mode, in mode-periods (0.8–3

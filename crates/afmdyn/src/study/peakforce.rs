@@ -14,7 +14,7 @@
 //! the request's document ([`document`]: channels, modulus, cycle, curve, the sweep's block)
 //! and its arrays (`Datasets`).
 
-use super::peakforce_sweep::SweepTap;
+use super::peakforce_sweep::{SweepTap, NOISE_COLUMNS};
 use super::Chain;
 use crate::analysis::peakforce::{
     low_pass_periodic, peak_force_setpoint, simulated_tap_noise, static_compliance, steady_tap,
@@ -24,6 +24,7 @@ use crate::analysis::peakforce::{
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::exact::ThermalForce;
+use crate::layout::columns::{self, UnitNames};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::{Convergence, CurveUnits};
@@ -499,18 +500,21 @@ fn thermal_block(
             .collect(),
         None => vec![(n, &r.tap)],
     };
-    let large = [("peak force", 0), ("deformation", 1)]
-        .into_iter()
-        .filter(|&(_, k)| {
-            taps.iter().any(|(n, tap)| {
-                let c = &tap.channels;
-                let (sigma, value) =
-                    [(n.peak_force, c.peak_force), (n.deformation, c.deformation)][k];
-                sigma > MAX_LINEAR_NOISE * value.abs()
-            })
-        })
-        .map(|(name, _)| name)
-        .collect::<Vec<_>>();
+    // a channel whose σ passes MAX_LINEAR_NOISE of its value at some tap
+    let over = |sigma: f64, value: f64| sigma > MAX_LINEAR_NOISE * value.abs();
+    let mut large = Vec::new();
+    if taps
+        .iter()
+        .any(|(n, t)| over(n.peak_force, t.channels.peak_force))
+    {
+        large.push("peak force");
+    }
+    if taps
+        .iter()
+        .any(|(n, t)| over(n.deformation, t.channels.deformation))
+    {
+        large.push("deformation");
+    }
     if !large.is_empty() {
         let (what, percent) = (large.join(" and "), MAX_LINEAR_NOISE * 100.0);
         warnings.push(warning!(
@@ -556,12 +560,14 @@ fn thermal_block(
             "deformation_quantiles": scaled(&s.deformation_quantiles, u.length),
         })
     });
+    let mut units = columns::units(&NOISE_COLUMNS, &UnitNames::si_or_model(u.si));
+    units.insert("temperature".into(), "K".into());
     Some(json!({
         "temperature": t,
         "peak_force_noise": n.peak_force * u.force,
         "deformation_noise": n.deformation * u.length,
         "simulated": simulated,
-        "units": if u.si { json!({"temperature": "K", "peak_force_noise": "N", "deformation_noise": "m"}) } else { json!({"temperature": "K", "peak_force_noise": "F", "deformation_noise": "g0"}) },
+        "units": units,
         "method": "standard deviations from cycle to cycle of the force and the deformation at their peaks' times (the per-cycle maxima's where the peak is sharp: thermal.flat-peak) under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
     }))
 }

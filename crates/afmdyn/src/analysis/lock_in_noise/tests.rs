@@ -7,6 +7,7 @@
 
 use super::*;
 use crate::analysis::am_loop::{demodulate_period, LockIn};
+use crate::analysis::peakforce::batch_variance;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, ShootingOptions};
 use crate::analysis::thermal::{thermal_spectrum, ModelUnits, BOLTZMANN};
@@ -219,33 +220,15 @@ fn setpoint_agrees(probe: &Probe) {
             series[1].push(lock.phase());
         }
     }
+    // within 4 standard errors of the batch means (batches much longer than the output's
+    // correlation)
     let predicted = [noise.amplitude.powi(2), noise.phase.powi(2)];
-    agrees_by_batch_means("", &["amplitude", "phase"], &series, per, &predicted);
-}
-
-/// Each of `series` (a simulated run's outputs) has the variance `predicted` within 4 standard
-/// errors: each batch of `per` outputs gives its mean square about the whole run's mean; their
-/// mean is the variance, their spread its standard error (batches much longer than the
-/// output's correlation).
-pub(crate) fn agrees_by_batch_means(
-    case: &str,
-    names: &[&str],
-    series: &[Vec<f64>],
-    per: usize,
-    predicted: &[f64],
-) {
-    for ((what, s), pred) in names.iter().zip(series).zip(predicted) {
-        let m = s.iter().sum::<f64>() / s.len() as f64;
-        let v: Vec<f64> = (s.chunks(per))
-            .map(|b| b.iter().map(|x| (x - m).powi(2)).sum::<f64>() / per as f64)
-            .collect();
-        let n = v.len() as f64;
-        let mean = v.iter().sum::<f64>() / n;
-        let se = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-        println!("{case} {what}: simulated {mean:.4e} ± {se:.2e}, linear response {pred:.4e}");
+    for ((what, s), pred) in ["amplitude", "phase"].iter().zip(&series).zip(predicted) {
+        let [mean, se] = batch_variance(s, per, usize::MAX);
+        println!("{what}: simulated {mean:.4e} ± {se:.2e}, linear response {pred:.4e}");
         assert!(
             (mean - pred).abs() < 4.0 * se,
-            "{case} {what}: {mean} ± {se} vs {pred}"
+            "{what}: {mean} ± {se} vs {pred}"
         );
     }
 }

@@ -143,8 +143,7 @@ pub fn tap_noise(
     integrator: IntegratorOptions,
 ) -> Result<TapNoise, SimError> {
     let end = periods.max(1) as f64 * model.period();
-    let omega1 = crate::eigen::natural_modes(model.galerkin().region(Region::Free)).omega[0];
-    let h = ETA / omega1;
+    let h = ETA / super::first_natural_frequency(model);
     let mut walk = Walk::new(model, z, kt, 0, integrator)?;
     let (n, dim) = (model.modes(), z.len());
     let stiffness = 1.0 / super::static_compliance(model);
@@ -162,10 +161,8 @@ pub fn tap_noise(
     while walk.tau < end {
         crate::error::cancelled()?;
         walk.adaptive_part(end, h)?;
-        let (tau, s) = (walk.tau, &walk.state);
-        let r = model.region_at(tau, s);
-        let e = model.tip_force_eval(r, model.base_trig(tau), s.as_slice());
-        snap_in |= r == Region::Free && -e.d_delta > stiffness;
+        let (tau, s, e) = (walk.tau, &walk.state, walk.force);
+        snap_in |= walk.region == Region::Free && -e.d_delta > stiffness;
         // F_c's gradient −(∂F/∂δ φ, ∂F/∂δ̇ φ), its rate's elastic part −∂F/∂δ φ on ȧ
         let force_grads = || {
             let g = gradient(-e.d_delta, -e.d_rate);
@@ -291,17 +288,24 @@ pub fn simulated_tap_noise(
 
 /// σ of `v` and its standard error by batch means (the module's [`BATCHES`]).
 fn sigma(v: &[f64]) -> [f64; 2] {
-    let mean = v.iter().sum::<f64>() / v.len() as f64;
-    let per = v.len() / BATCHES;
-    let batches: Vec<f64> = (v.chunks_exact(per).take(BATCHES))
-        .map(|b| b.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / per as f64)
-        .collect();
-    let n = batches.len() as f64;
-    let var = batches.iter().sum::<f64>() / n;
-    let se_var = (batches.iter().map(|b| (b - var).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let [var, se_var] = batch_variance(v, v.len() / BATCHES, BATCHES);
     let s = var.sqrt();
     // σ's standard error from the variance's, δσ = δ(σ²)/(2σ)
     [s, if s > 0.0 { se_var / (2.0 * s) } else { 0.0 }]
+}
+
+/// The variance of the series `v` about its mean and the variance's standard error, by the
+/// mean squares of its first `batches` batches of `per` values (batches much longer than the
+/// series' correlation: their spread is the standard error).
+pub(crate) fn batch_variance(v: &[f64], per: usize, batches: usize) -> [f64; 2] {
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    let squares: Vec<f64> = (v.chunks_exact(per).take(batches))
+        .map(|b| b.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / per as f64)
+        .collect();
+    let n = squares.len() as f64;
+    let var = squares.iter().sum::<f64>() / n;
+    let se = (squares.iter().map(|b| (b - var).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    [var, se]
 }
 
 /// The 1 %, 50 % and 99 % quantiles of `v` (the nearest rank).

@@ -244,15 +244,8 @@ pub(crate) fn linear_part(model: &CantileverModel) -> Result<CantileverModel, Si
 
 /// The contact's rate ω_c = (|∂F_c/∂δ|/m_eff)^{1/2} + |∂F_c/∂δ̇|/m_eff of the tip force `e`
 /// (module docs): the spring's natural frequency and the dashpot's decay rate at the tip.
-fn rate_of(e: &crate::contact::ForceEval, m_eff: f64) -> f64 {
+pub(crate) fn rate_of(e: &crate::contact::ForceEval, m_eff: f64) -> f64 {
     (e.d_delta.abs() / m_eff).sqrt() + e.d_rate.abs() / m_eff
-}
-
-/// [`rate_of`] the tip force of `model` at (τ, z) (0 where none acts).
-pub(crate) fn contact_rate(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> f64 {
-    let r = model.region_at(tau, z);
-    let e = model.tip_force_eval(r, model.base_trig(tau), z.as_slice());
-    rate_of(&e, model.effective_mass())
 }
 
 /// How far apart, in ulps of τ, a target time and the lattice point it names may be rounded
