@@ -41,6 +41,21 @@ def test_fm_equals_the_command_line_and_inverts_to_the_force(cli_json, tmp_path)
     np.testing.assert_allclose(k2.force.values, 2 * back.force.values, rtol=1e-12)
 
 
+def test_fm_temperature_equals_the_command_line(cli_json):
+    # the loops' thermal noise (the library's linear response, tested there against a
+    # simulated loop and Albrecht's formula) reaches the dataset as the command line's
+    doc = cli_json("fm", "--probe", P1, "--points", "3", "--temperature", "295",
+                   "--bandwidth", "50Hz", "--files", "none")
+    ds = afmdyn.fm(probe=P1, points=3, temperature=295.0, bandwidth=50.0)
+    assert afmdyn.summary(ds) == doc
+    assert ds.frequency_shift_noise.values.tolist() == doc["curve"]["frequency_shift_noise"]
+    assert ds.frequency_shift_noise.attrs["units"] == "Hz"
+    assert doc["thermal"]["bandwidth"] == pytest.approx(50.0, rel=1e-12)
+    assert "frequency_shift_noise" not in afmdyn.fm(probe=P1, points=3)
+    with pytest.raises(ValueError, match="bandwidth"):
+        afmdyn.fm(probe=P1, points=3, bandwidth=50.0)
+
+
 def test_bad_fm_options_name_them():
     with pytest.raises(ValueError, match="amplitude"):
         afmdyn.fm(probe=P1, amplitude=-1e-9, points=3)

@@ -137,6 +137,8 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("fm", ["--points", 4]),
     ("fm", ["--points", 4, "--probe", P1]),
     ("fm", ["--points", 4, "--mode", 2, "--probe", EIG]),
+    # the thermal block and the curve's noise columns
+    ("fm", ["--points", 3, "--probe", P1, "--temperature", 295, "--bandwidth", "50Hz"]),
     ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
     ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM]),
     ("bimodal", ["--points", 2, "--files", "none", "--average", "--probe", BIM]),

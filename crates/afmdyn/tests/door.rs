@@ -367,7 +367,11 @@ fn case(name: &str) -> Option<Case> {
         ),
         "fm" => Case {
             probe: Some(FM),
-            sizes: [json!({"points": 8}), json!({"points": 40})],
+            // with the loops' thermal noise at every point (its declared work)
+            sizes: [
+                json!({"points": 8}),
+                json!({"points": 40, "temperature": 295.0}),
+            ],
             long: Some(json!({"points": 100000})),
             long_params: None,
         },

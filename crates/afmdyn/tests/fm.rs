@@ -293,3 +293,76 @@ fn the_second_mode_follows_giessibl_with_its_own_stiffness() {
         );
     }
 }
+
+/// `fm` with a temperature (the Q = 400 lever of `PROBE` at A = 10 nm, 295 K): far from the
+/// sample, where the lever is free, σ of the frequency shift at the loops' bandwidth is
+/// Albrecht's thermal frequency noise √(f₀ k_BT B/(π k Q A²)) (Albrecht, Grütter, Horne & Rugar,
+/// *J. Appl. Phys.* 69 (1991) 668, eq. 11) within 1 % for a loop slow against the lever
+/// (B = 20 Hz against f₀/2Q = 375 Hz; measured 10⁻⁵); at 0.6 nm from the sample (Δf = −19 Hz)
+/// the force gradient turns the amplitude's noise into the frequency's: σ is 1.33 times it.
+/// The document's `thermal` block states T, B and the gain; σ scales as √T (1 180 K warns, a
+/// value in °C?) and, for the slow loop, as √B; a bandwidth without a temperature, or
+/// faster than the lever, is refused naming `bandwidth`; the table and the layout carry the
+/// columns.
+#[test]
+fn a_temperature_gives_the_frequency_shift_noise() {
+    use afmdyn::request::{named, Resolved};
+    let text = PROBE.replace("quality_factor = 1e4", "quality_factor = 400");
+    let probe = Probe::parse(&text, "q400").unwrap();
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let request = |t: f64, b: f64| {
+        let r = serde_json::json!({"temperature": t, "bandwidth": b, "from": 20e-9,
+            "to": 10.6e-9, "points": 4});
+        named::parse("fm", r).unwrap().unwrap()
+    };
+    let run = |t: f64, b: f64| request(t, b).run(&model, &Default::default()).unwrap();
+    let out = run(295.0, 20.0);
+    let doc = &out.document;
+    assert_eq!(doc["warnings"], serde_json::json!([]));
+    let sigma =
+        |d: &serde_json::Value, i: usize| d["curve"]["frequency_shift_noise"][i].as_f64().unwrap();
+    let (f0, k, q, a) = (300e3, 40.0, 400.0, 10e-9);
+    let kt = 1.380_649e-23 * 295.0;
+    let albrecht = (f0 * kt * 20.0 / (PI * k * q * a * a)).sqrt();
+    println!("σ_Δf = {:.5e} Hz (Albrecht {albrecht:.5e})", sigma(doc, 0));
+    assert!(
+        (sigma(doc, 0) / albrecht - 1.0).abs() < 0.01,
+        "{}",
+        doc["thermal"]
+    );
+    assert!(sigma(doc, 3) > 1.2 * sigma(doc, 0), "{}", doc["curve"]);
+    assert_eq!(doc["thermal"]["temperature"], 295.0);
+    assert!((doc["thermal"]["bandwidth"].as_f64().unwrap() / 20.0 - 1.0).abs() < 1e-12);
+    assert_eq!(doc["units"]["frequency_shift_noise"], "Hz");
+    let hot = run(4.0 * 295.0, 20.0).document;
+    assert!((sigma(&hot, 2) / sigma(doc, 2) - 2.0).abs() < 1e-9);
+    assert!(
+        hot["warnings"][0].as_str().unwrap().contains("°C"),
+        "{}",
+        hot["warnings"]
+    );
+    let wide = run(295.0, 80.0).document;
+    assert!((sigma(&wide, 0) / sigma(doc, 0) - 2.0).abs() < 0.02);
+    let layout = &out.datasets[0].1;
+    assert!(layout
+        .variables
+        .iter()
+        .any(|v| v.name == "excitation_noise"));
+    let refused = |r: serde_json::Value| {
+        let r = named::parse("fm", r).unwrap().unwrap();
+        r.run(&model, &Default::default()).unwrap_err().to_string()
+    };
+    let alone = refused(serde_json::json!({"bandwidth": 20.0, "points": 2}));
+    assert!(
+        alone.contains("bandwidth") && alone.contains("temperature"),
+        "{alone}"
+    );
+    let fast = refused(serde_json::json!({"temperature": 295.0, "bandwidth": 1e4, "points": 2}));
+    assert!(
+        fast.contains("bandwidth") && fast.contains("outruns"),
+        "{fast}"
+    );
+}

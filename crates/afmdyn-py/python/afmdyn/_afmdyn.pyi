@@ -395,10 +395,12 @@ FmRequest = TypedDict(
     "FmRequest",
     {
         "amplitude": Optional[float],  # default null
+        "bandwidth": Optional[float],  # default null
         "from": Optional[float],  # default null
         "mode": int,  # default 1
         "points": Optional[int],  # default null
         "step": Optional[float],  # default null
+        "temperature": Optional[float],  # default null
         "to": Optional[float],  # default null
         "tolerance": float,  # default 1e-09
     },

@@ -581,16 +581,18 @@ def resonance(
     return _api._finish_resonance(locals())
 
 
-@_typed(si={"amplitude": "length", "from_": "length", "step": "length", "to": "length"})
+@_typed(si={"amplitude": "length", "bandwidth": "frequency", "from_": "length", "step": "length", "to": "length"})
 def fm(
     params: Optional[Params] = None,
     /,
     *,
     amplitude: Optional[float] = None,
+    bandwidth: Optional[float] = None,
     from_: Optional[float] = None,
     mode: int = 1,
     points: Optional[int] = None,
     step: Optional[float] = None,
+    temperature: Optional[float] = None,
     to: Optional[float] = None,
     tolerance: float = 1e-09,
     progress: ProgressArg = None,
@@ -608,12 +610,22 @@ def fm(
     Args:
         amplitude: The first-harmonic amplitude A the amplitude controller holds (m with a
             probe, else g₀), > 0; default the probe's free amplitude A₀ (1 g₀).
+        bandwidth: The loops' equivalent noise bandwidth B (Hz; with ``temperature``), > 0
+            and at most ≈ π f_K/(4Q_K) (a gain π/Q_K per cycle, where they would outrun the
+            lever); ``None``: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K)
+            (``analysis::fm_loop::LoopSpec``).
         from_: First z_c of the approach (default: where the frequency shift has decayed to
             0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower
             turning point at A, for the laws without a force before contact).
         mode: The mode K (1-based) the PLL tracks; default 1.
         points: Number of z_c values, ends included, 2..=100000 (default 120).
         step: Step of z_c; excludes ``points``.
+        temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
+            200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
+            every point gains σ of the frequency shift and of the excitation that the loops
+            read under the lever's thermal force, by linear response of the closed loop
+            (``analysis::fm::noise``), and the document a ``"thermal"`` block. Needs the
+            probe's SI units; laws with memory are refused.
         to: Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0
             for the laws without attraction).
         tolerance: Tolerance of the loop conditions, ``|A₁/A − 1|`` and ``|φ₁ − φ_set|``

@@ -59,6 +59,7 @@ use nalgebra::{Complex, DVector, Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub mod noise;
 mod solver;
 use solver::{predict, Locked, Solver};
 
@@ -239,6 +240,9 @@ pub struct FmPoint {
     pub law_force: f64,
     /// The orbit's observables (harmonics, forces, E_dis, virial, …).
     pub observables: Observables,
+    /// The loops' thermal noise here ([`noise`]), with a temperature.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<noise::FmNoise>,
 }
 
 /// A fold of the FM curve: between the values of points `index` and `index + 1`.
@@ -353,6 +357,7 @@ fn followed(
             loop_residual: locked.residual.amax(),
             law_force: law_force(&p, observables.min_distance),
             observables,
+            noise: None,
         });
         if let Some(p) = progress {
             p.tick();

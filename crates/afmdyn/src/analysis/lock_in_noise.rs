@@ -103,7 +103,7 @@ pub fn lock_in_noise(
 
 /// The chain of the orbit through (0, `z`) over one period, the lock-in's four states X, Y, X̄,
 /// Ȳ after the deviation, and the orbit's first harmonic (X, Y).
-fn period_chain(
+pub(crate) fn period_chain(
     model: &CantileverModel,
     z: &DVector<f64>,
     kt: f64,

@@ -44,6 +44,31 @@ pub const ETA: f64 = std::f64::consts::TAU / 512.0;
 /// chain whose slowest decay per period is 1 − 10⁻¹⁵ or faster.
 const DOUBLINGS: usize = 64;
 
+/// Within how many of the free lever's thermal standard deviations √(k_BT c_s) of the surface
+/// (c_s its static compliance at the tip) an orbit's lowest point may pass, above it or inside
+/// it, before the noise changes its contacts from period to period: a linear response there is
+/// beyond its validity ([`grazing`]).
+pub(crate) const NOISE_GRAZING: f64 = 5.0;
+
+/// How many of the orbits on `base` whose lowest points' tip–sample distances are
+/// `min_distances` (g₀) pass within [`NOISE_GRAZING`] thermal standard deviations of the
+/// surface at k_B T = `kt`.
+///
+/// # Errors
+/// The model's.
+pub(crate) fn grazing(
+    base: &crate::Params,
+    kt: f64,
+    min_distances: impl Iterator<Item = f64>,
+) -> Result<usize, SimError> {
+    let model = CantileverModel::new(base)?;
+    let sigma = (kt * crate::analysis::peakforce::static_compliance(&model)).sqrt();
+    let offset = base.contact_law.distance_offset();
+    Ok(min_distances
+        .filter(|d| (d - offset).abs() < NOISE_GRAZING * sigma)
+        .count())
+}
+
 /// The chain y ↦ F y + ξ, ξ ~ N(0, W), from the period's start to the walk's time (module docs).
 #[derive(Debug, Clone)]
 pub(crate) struct Chain {

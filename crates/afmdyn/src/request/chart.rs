@@ -335,14 +335,12 @@ impl ChartRequest {
         }
         in_range("tile", self.tile, 1..=MAX_CHART_TILE)?;
         super::limits::positive("cluster_tol", self.cluster_tol, "must be finite and > 0")?;
-        if self.lyapunov_periods > MAX_CHART_LYAPUNOV_PERIODS
-            || (1..10).contains(&self.lyapunov_periods)
-        {
-            return Err(SimError::out_of_range(
-                "lyapunov_periods",
+        if self.lyapunov_periods != 0 {
+            let (n, why) = (
                 self.lyapunov_periods,
                 "must be 0 (no λ₁) or in 10..=1000000",
-            ));
+            );
+            crate::error::within("lyapunov_periods", n, 10..=MAX_CHART_LYAPUNOV_PERIODS, why)?;
         }
         in_range("max_attractors", self.max_attractors, 1..=MAX_CHART_SLOTS)?;
         crate::error::finite("x_from", self.x_from)?;

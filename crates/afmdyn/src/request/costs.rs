@@ -93,31 +93,29 @@ pub(crate) fn check_cost_advising(
         }
     };
     // NaN (an estimate that overflowed) is refused too
-    if cost.bytes.is_nan() || cost.bytes > MAX_REQUEST_BYTES {
-        return Err(SimError::Budget {
+    let over = |v: f64, most: f64, needed: String, budget: String, hint| {
+        let needed = needed + &fits(v / most);
+        let refused = SimError::Budget {
             what,
-            needed: format!(
-                "a peak memory of {:.2} GiB{}",
-                cost.bytes / GIB,
-                fits(cost.bytes / MAX_REQUEST_BYTES)
-            ),
-            budget: format!("{:.1} GiB", MAX_REQUEST_BYTES / GIB),
-            hint: memory_hint,
-        });
-    }
-    if cost.work.is_nan() || cost.work > MAX_REQUEST_WORK {
-        return Err(SimError::Budget {
-            what,
-            needed: format!(
-                "{:.3e} mode-periods (drive periods integrated × modes){}",
-                cost.work,
-                fits(cost.work / MAX_REQUEST_WORK)
-            ),
-            budget: format!("{MAX_REQUEST_WORK:.0e} mode-periods"),
-            hint: work_hint,
-        });
-    }
-    Ok(())
+            needed,
+            budget,
+            hint,
+        };
+        if v <= most {
+            Ok(())
+        } else {
+            Err(refused)
+        }
+    };
+    let gib = format!("{:.1} GiB", MAX_REQUEST_BYTES / GIB);
+    let memory = format!("a peak memory of {:.2} GiB", cost.bytes / GIB);
+    over(cost.bytes, MAX_REQUEST_BYTES, memory, gib, memory_hint)?;
+    let periods = format!(
+        "{:.3e} mode-periods (drive periods integrated × modes)",
+        cost.work
+    );
+    let most = format!("{MAX_REQUEST_WORK:.0e} mode-periods");
+    over(cost.work, MAX_REQUEST_WORK, periods, most, work_hint)
 }
 
 /// The cost of `values` censuses of attractors ([`AttractorSpec`]: `attractors`, and one per

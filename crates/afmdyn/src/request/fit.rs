@@ -355,25 +355,18 @@ impl FitRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming the option.
     fn check_noise(&self, model: &Resolved) -> Result<(), SimError> {
+        let needs = [
+            ("bandwidth", self.bandwidth),
+            ("detector_noise", self.detector_noise),
+        ];
+        super::limits::needs_temperature(self.temperature, &needs)?;
         let Some(t) = self.temperature else {
-            return match (self.bandwidth, self.detector_noise) {
-                (None, None) => Ok(()),
-                (b, _) => Err(bad(
-                    if b.is_some() {
-                        "bandwidth"
-                    } else {
-                        "detector_noise"
-                    },
-                    "given without a temperature",
-                    "the bandwidth and the detector noise set the thermal σ: give the temperature",
-                )),
-            };
+            return Ok(());
         };
         super::limits::check_temperature(t)?;
         let number = crate::error::number;
-        if let Some(b) = self.bandwidth.filter(|b| !(b.is_finite() && *b > 0.0)) {
-            return Err(bad("bandwidth", number(b), "finite and > 0 (Hz)"));
-        }
+        let positive = |b| super::limits::positive("bandwidth", b, "finite and > 0 (Hz)");
+        self.bandwidth.map(positive).transpose()?;
         if let Some(n) = self.detector_noise {
             let why = "finite and ≥ 0 (m/√Hz)";
             crate::error::within("detector_noise", n, 0.0..f64::INFINITY, why)?;

@@ -4,7 +4,7 @@
 //! their defaults, ranges and checks, and its declared cost. With a probe everything is SI (z_c and A in m, Δf in Hz, E_dis in J, forces in N);
 //! without one the model's units (g₀, Ω, F̃).
 
-use super::costs::{newton_work, state_bytes, MODEL_BYTES};
+use super::costs::{newton_work, state_bytes, MODEL_BYTES, NOISE_PERIODS};
 use super::curves::CurveRequest;
 use super::limits::Cost;
 use super::run::Resolved;
@@ -43,6 +43,19 @@ request! {
         pub points: Option<usize>,
         /// Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).
         pub tolerance: f64 = DEFAULT_LOOP_TOLERANCE,
+        /// The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns,
+        /// a value in °C?); `None` (the default): no noise. With one every point gains σ of the
+        /// frequency shift and of the excitation that the loops read under the lever's thermal
+        /// force, by linear response of the closed loop ([`crate::analysis::fm::noise`]), and the
+        /// document a `"thermal"` block. Needs the probe's SI units; laws with memory are refused.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub temperature: Option<f64>,
+        /// The loops' equivalent noise bandwidth B (Hz; with `temperature`), > 0 and at most
+        /// ≈ π f_K/(4Q_K) (a gain π/Q_K per cycle, where they would outrun the lever); `None`:
+        /// gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K) ([`crate::analysis::fm_loop::LoopSpec`]).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
+        pub bandwidth: Option<f64>,
     }
 }
 
@@ -133,14 +146,8 @@ impl FmRequest {
         };
         range.check_finite()?;
         if let Some(a) = self.amplitude {
-            crate::error::finite("amplitude", a)?;
-            if a <= 0.0 {
-                return Err(SimError::out_of_range(
-                    "amplitude",
-                    a,
-                    "must be > 0: the oscillation amplitude the controller holds",
-                ));
-            }
+            let why = "must be > 0: the oscillation amplitude the controller holds";
+            super::limits::positive("amplitude", a, why)?;
             if length != 1.0 {
                 // an amplitude's range is the probe's amplitude's ([`crate::probe::ranges`]),
                 // not a rest distance's
@@ -184,6 +191,10 @@ impl FmRequest {
         for v in [values[0], values[values.len() - 1]] {
             base.with(crate::params::SweepParam::Alpha5, v).validate()?;
         }
+        let needs = [("bandwidth", self.bandwidth)];
+        super::limits::optional_kt(self.temperature, &needs, model)?;
+        let positive = |b| super::limits::positive("bandwidth", b, "must be > 0 (Hz)");
+        self.bandwidth.map(positive).transpose()?;
         let mut spec = FmSpec::new(base, values, a);
         spec.mode = self.mode;
         spec.tolerance = self.tolerance;
@@ -204,9 +215,12 @@ impl_request! {
         let p = &spec.base;
         let points = spec.values.len() as f64;
         let steps = (MAX_LOOP_ITERATIONS * MAX_HALVINGS) as f64;
+        // the loop's noise: the orbit's chain over a period in 1 024 parts (the lock-in's two
+        // NOISE_PERIODS per 512) and five cycles of its differences
+        let noise = r.temperature.map_or(0.0, |_| (4.0 * NOISE_PERIODS + 5.0) * p.modes as f64);
         Ok(Cost {
             bytes: MODEL_BYTES + points * (4.0 * state_bytes(p) + 512.0),
-            work: points * steps * newton_work(p, 1, &spec.newton),
+            work: points * (steps * newton_work(p, 1, &spec.newton) + noise),
         })
     }
 }

@@ -201,3 +201,36 @@ pub(crate) fn thermal_kt(t: f64, model: &super::Resolved) -> Result<f64, crate::
     crate::integrate::exact::noise::admits_model(&model.params)?;
     Ok(kt)
 }
+
+/// Refuse the options of `needs` (name, value) that only a temperature `t` gives a meaning
+/// where there is none.
+///
+/// # Errors
+/// [`crate::SimError::OutOfRange`] naming the first option given without a temperature.
+pub(crate) fn needs_temperature(
+    t: Option<f64>,
+    needs: &[(&'static str, Option<f64>)],
+) -> Result<(), crate::SimError> {
+    let (number, why) = (
+        crate::error::number,
+        "belongs to the thermal noise, which needs a temperature: give it too, or drop this",
+    );
+    match needs.iter().find(|(_, v)| t.is_none() && v.is_some()) {
+        Some(&(name, Some(v))) => Err(crate::SimError::out_of_range(name, number(v), why)),
+        _ => Ok(()),
+    }
+}
+
+/// k_B T of a request's optional temperature `t` ([`thermal_kt`]; `None` without one), where
+/// `needs` lists the options that only a temperature gives a meaning ([`needs_temperature`]).
+///
+/// # Errors
+/// As [`thermal_kt`] and [`needs_temperature`].
+pub(crate) fn optional_kt(
+    t: Option<f64>,
+    needs: &[(&'static str, Option<f64>)],
+    model: &super::Resolved,
+) -> Result<Option<f64>, crate::SimError> {
+    needs_temperature(t, needs)?;
+    t.map(|t| thermal_kt(t, model)).transpose()
+}

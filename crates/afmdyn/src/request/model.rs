@@ -502,13 +502,12 @@ impl ModelSpec {
 fn alpha5_of_rest_distance(z: f64, p: &Params, probe: Option<&Probe>) -> Result<f64, SimError> {
     let probe = probe
         .ok_or_else(|| SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)"))?;
-    if !z.is_finite() {
-        return Err(SimError::out_of_range(
-            "z_c",
-            z,
-            "must be a finite distance in m",
-        ));
-    }
+    crate::error::within(
+        "z_c",
+        z,
+        f64::MIN..=f64::MAX,
+        "must be a finite distance in m",
+    )?;
     super::limits::si_distance("z_c", z)?;
     let alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
     if alpha5.is_nan() || alpha5.abs() > crate::params::DISPLACEMENT_MAX {

@@ -145,18 +145,12 @@ impl PeakForceRequest {
             // below it (1e-308) its periodic steady state is singular (issue 77 §3)
             let dt = self.sampling_interval(model, &p);
             let (modulation, nyquist) = (1.0 / (dt * self.samples as f64), 0.5 / dt);
-            if !(fc.is_finite() && fc >= modulation && fc < nyquist) {
-                return Err(SimError::out_of_range(
-                    "filter_cutoff",
-                    fc,
-                    format!(
-                        "must be a cut-off frequency from the modulation frequency, \
-                         {modulation:.6e} (below it the filter leaves little but the cycle's \
-                         mean), to below the Nyquist frequency of the cycle's samples, \
-                         {nyquist:.6e} (raise samples to raise it)"
-                    ),
-                ));
-            }
+            let why = format!(
+                "must be a cut-off frequency from the modulation frequency, {modulation:.6e} \
+                 (below it the filter leaves little but the cycle's mean), to below the Nyquist \
+                 frequency of the cycle's samples, {nyquist:.6e} (raise samples to raise it)"
+            );
+            crate::error::within("filter_cutoff", fc, modulation..nyquist, why)?;
         }
         let length = model.units(true).length;
         let mut q = p;
@@ -199,13 +193,14 @@ impl PeakForceRequest {
     /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe);
     /// [`SimError::Unsupported`] for a law with memory.
     pub(crate) fn thermal(&self, model: &Resolved) -> Result<Option<f64>, SimError> {
+        let cycles = self.thermal_cycles.map(|n| n as f64);
+        let kt =
+            super::limits::optional_kt(self.temperature, &[("thermal_cycles", cycles)], model)?;
         if let Some(n) = self.thermal_cycles {
-            let why = "must be at least 100 modulation cycles, with a temperature";
-            let least = self.temperature.map_or(usize::MAX, |_| MIN_THERMAL_CYCLES);
-            crate::error::within("thermal_cycles", n, least.., why)?;
+            let why = "must be at least 100 modulation cycles";
+            crate::error::within("thermal_cycles", n, MIN_THERMAL_CYCLES.., why)?;
         }
-        let kt = |t| super::limits::thermal_kt(t, model);
-        self.temperature.map(kt).transpose()
+        Ok(kt)
     }
 
     /// The integrator's steps per modulation period on `p` against its budget
@@ -270,13 +265,8 @@ impl PeakForceRequest {
         p: &Params,
     ) -> Result<Vec<Params>, SimError> {
         let n = sweep.values.len();
-        if n == 0 || n > MAX_SWEEP_POINTS {
-            return Err(SimError::out_of_range(
-                "sweep",
-                n,
-                format!("must have 1..={MAX_SWEEP_POINTS} values"),
-            ));
-        }
+        let why = format!("must have 1..={MAX_SWEEP_POINTS} values");
+        crate::error::within("sweep", n, 1..=MAX_SWEEP_POINTS, why)?;
         let units = model.units(true);
         let bad = |v: f64, why: &str| {
             SimError::out_of_range("sweep", v, format!("{}: {why}", sweep.quantity.name()))

@@ -359,14 +359,10 @@ impl ApproachRequest {
     /// (multifrequency) or `time_constant` (out of range, or without a temperature);
     /// [`SimError::Unsupported`] for a law with memory.
     fn thermal(&self, model: &Resolved) -> Result<Option<ThermalLockIn>, SimError> {
-        let Some(t) = self.temperature else {
-            let why = "sets the lock-in of the thermal noise, which needs a temperature: give \
-                       temperature too, or drop it";
-            let refuse =
-                |tc| SimError::out_of_range("time_constant", crate::error::number(tc), why);
-            return self.time_constant.map_or(Ok(None), |tc| Err(refuse(tc)));
+        let needs = [("time_constant", self.time_constant)];
+        let Some(kt) = super::limits::optional_kt(self.temperature, &needs, model)? else {
+            return Ok(None);
         };
-        let kt = super::limits::thermal_kt(t, model)?;
         let probe = model.probe.as_ref().expect("thermal_force checked it");
         let tc = super::image_scan::lock_in_time_constant(probe, self.time_constant)?;
         Ok(Some(ThermalLockIn {

@@ -3,7 +3,10 @@
 //! (z_c and A in m, Δf in Hz, E_dis in J, forces in N); without one the model's units
 //! (g₀, Ω, F̃).
 
-use crate::analysis::fm::{fm_curve, FmCurve, FmPoint, FmReference};
+use crate::analysis::fm::noise::{curve_noise, loop_bandwidth, loop_gain};
+use crate::analysis::fm::{fm_curve, fm_reference, FmCurve, FmPoint, FmReference, FmSpec};
+use crate::analysis::fm_loop::LoopSpec;
+use crate::analysis::orbit_noise::{grazing, NOISE_GRAZING};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::layout::columns::{self, columns, Column, UnitNames};
@@ -21,7 +24,16 @@ impl Analysis for FmRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
         crate::request::curves::check_single_frequency(&model.params, "fm")?;
-        fm_curve(&self.spec(model)?, progress)
+        let spec = self.spec(model)?;
+        let noise = self
+            .temperature
+            .map(|_| gains(self, model, &spec))
+            .transpose()?;
+        let mut curve = fm_curve(&spec, progress)?;
+        if let Some((gains, kt)) = noise {
+            curve_noise(&spec.base, &mut curve, &gains, kt)?;
+        }
+        Ok(curve)
     }
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
         Ok(document(self, model, curve))
@@ -41,6 +53,33 @@ impl Analysis for FmRequest {
         let d = curve.points.iter().map(|q| q.observables.indentation);
         Some(d.filter(|d| d.is_finite()).fold(0.0, f64::max))
     }
+}
+
+/// The loops' gains of `request`'s bandwidth (its default: [`LoopSpec::new`]) and k_B T.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `bandwidth` above the lever's (a gain π/Q_K per cycle) or
+/// `temperature`; as `fm_reference`.
+fn gains(
+    request: &FmRequest,
+    model: &Resolved,
+    spec: &FmSpec,
+) -> Result<(LoopSpec, f64), SimError> {
+    let needs = [("bandwidth", request.bandwidth)];
+    let kt = crate::request::limits::optional_kt(request.temperature, &needs, model)?;
+    let r = fm_reference(&spec.base, spec.mode, spec.amplitude)?;
+    let mut gains = LoopSpec::new(r.quality_factor);
+    if let Some(b) = request.bandwidth {
+        let f_k = r.omega * model.units(true).hz_per_omega.unwrap_or(1.0);
+        let most = loop_bandwidth(std::f64::consts::PI / r.quality_factor, f_k);
+        let why = format!(
+            "must be at most {} Hz here, π f_K/(4Q_K): a faster loop outruns the lever",
+            crate::error::number(most)
+        );
+        crate::error::within("bandwidth", b, ..=most, why)?;
+        (gains.phase_gain, gains.amplitude_gain) = (loop_gain(b, f_k), loop_gain(b, f_k));
+    }
+    Ok((gains, kt.expect("called with a temperature")))
 }
 
 /// What an FM point's columns ([`COLUMNS`]) are read through: the document's units, Hz per
@@ -110,6 +149,26 @@ const COLUMNS: [Column<Frame, FmPoint>; 18] = columns! {
     "iterations", Fixed("1"), false, "Newton iterations on (Ω, α2)", Count(|_, q| q.iterations);
 };
 
+/// The columns a curve with a temperature adds after [`COLUMNS`]: the loops' thermal noise
+/// (`crate::analysis::fm::noise`).
+const NOISE_COLUMNS: [Column<Frame, FmPoint>; 2] = columns! {
+    "frequency_shift_noise", Own("Hz", "Ω (units of the τ scale)"), true,
+        "thermal noise of the frequency shift (σ)", Opt(|f, q| Some(q.noise?.frequency * f.hz));
+    "excitation_noise", Own("1 (relative to the free lever's at its resonance)", "1 (relative)"),
+        true, "thermal noise of the excitation (σ)",
+        Opt(|f, q| Some(q.noise?.excitation / f.reference.excitation));
+};
+
+/// The noise columns of `curve`: [`NOISE_COLUMNS`] with a temperature, none without.
+fn noise_columns(curve: &FmCurve) -> &'static [Column<Frame, FmPoint>] {
+    let noisy = curve.points.first().is_some_and(|q| q.noise.is_some());
+    if noisy {
+        &NOISE_COLUMNS
+    } else {
+        &[]
+    }
+}
+
 /// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
 /// per quantity of `COLUMNS`, one entry per z_c reached), `folds`, `reference` (the free
 /// lever's operating point), the cantilever's constants that [`super::reconstruct`] needs
@@ -120,12 +179,16 @@ pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -
     let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
     let spring_constant = r.stiffness * u.force / u.length;
-    let mut units = columns::units(&COLUMNS, &UnitNames::si_or_model(frame.u.si));
+    let names = UnitNames::si_or_model(frame.u.si);
+    let mut units = columns::units(&COLUMNS, &names);
+    units.extend(columns::units(noise_columns(curve), &names));
     if u.si {
         units.insert("spring_constant".into(), "N/m".into());
     }
+    let mut arrays = columns::arrays(&COLUMNS, &frame, &curve.points);
+    arrays.extend(columns::arrays(noise_columns(curve), &frame, &curve.points));
     json!({
-        "curve": columns::arrays(&COLUMNS, &frame, &curve.points),
+        "curve": arrays,
         "folds": curve.folds.iter().map(|f| json!({"index": f.index, "z_c": frame.z_c(f.alpha5)})).collect::<Vec<_>>(),
         "reference": {
             "resonance_frequency": r.omega * hz,
@@ -138,9 +201,29 @@ pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -
         "amplitude": curve.amplitude * u.length,
         "spring_constant": spring_constant,
         "resonance_frequency": r.omega * hz,
+        "thermal": thermal(request, model, curve),
         "units": units,
         "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/tutorials/fm.md)",
         "warnings": warnings(request, model, &frame, curve),
+    })
+}
+
+/// The `"thermal"` block of an FM curve with a temperature (`null` without): `temperature`
+/// (K), the loops' `bandwidth` (Hz, [`loop_bandwidth`]) and `gain` per cycle, and the
+/// `method`; σ of each point in the curve's [`NOISE_COLUMNS`].
+fn thermal(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
+    let Some(t) = request.temperature else {
+        return Value::Null;
+    };
+    let spec = request.spec(model).expect("admitted");
+    let (gains, _) = gains(request, model, &spec).expect("admitted");
+    let hz = model.units(true).hz_per_omega.unwrap_or(1.0);
+    json!({
+        "temperature": t,
+        "bandwidth": loop_bandwidth(gains.phase_gain, curve.reference.omega * hz),
+        "gain": gains.phase_gain,
+        "columns": columns::names(&NOISE_COLUMNS),
+        "method": "linear response of the closed loop (a PLL and an amplitude controller updated once per cycle from the first harmonic of 64 samples) about the FM orbit under the fluctuation-dissipation theorem's thermal force: the orbit's chain over a period, its switchings and the noise within it included, and the stationary covariance of the loop's state (docs/tutorials/thermal.md)",
     })
 }
 
@@ -173,6 +256,33 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
             ));
         }
     }
+    if let Some(t) = request.temperature {
+        warnings.extend(crate::request::limits::temperature_warnings(t));
+        let kt = crate::request::limits::thermal_kt(t, model).expect("admitted");
+        let lowest = curve.points.iter().map(|q| q.observables.min_distance);
+        let near = grazing(&model.params, kt, lowest).expect("admitted");
+        if near > 0 {
+            warnings.push(warning!(
+                "fm.noise-grazing",
+                "Read their frequency_shift_noise as an estimate only.",
+                "{near} point(s) pass within {NOISE_GRAZING} thermal standard deviations \
+                 √(k_BT/k) of the surface, above or inside it, where the noise adds or removes \
+                 contacts from cycle to cycle: their loop noise is beyond the linear response"
+            ));
+        }
+        if curve
+            .points
+            .iter()
+            .any(|q| q.noise.is_some_and(|n| n.frequency.is_nan()))
+        {
+            warnings.push(warning!(
+                "fm.noise-unstable",
+                "Give a smaller bandwidth.",
+                "the closed loop is unstable at some z_c: their frequency_shift_noise is null \
+                 (no stationary noise at this bandwidth)"
+            ));
+        }
+    }
     if let Some(u) = &curve.unreached {
         warnings.push(warning!(
             "fm.unreached",
@@ -195,13 +305,10 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
 pub(crate) fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout {
     let frame = Frame::new(model, curve);
     let p = &curve.points;
-    let variables = columns::variables(
-        &COLUMNS,
-        &frame,
-        p,
-        &["z_c"],
-        &UnitNames::si_or_model(frame.u.si),
-    );
+    let names = UnitNames::si_or_model(frame.u.si);
+    let mut variables = columns::variables(&COLUMNS, &frame, p, &["z_c"], &names);
+    let noise = noise_columns(curve);
+    variables.extend(columns::variables(noise, &frame, p, &["z_c"], &names));
     crate::layout::Layout::new("fm", &[("z_c", p.len())], variables)
 }
 
@@ -209,8 +316,17 @@ pub(crate) fn layout(model: &Resolved, curve: &FmCurve) -> crate::layout::Layout
 /// (`stable` as 1/0).
 pub(crate) fn table(model: &Resolved, curve: &FmCurve) -> (Vec<&'static str>, Vec<Vec<f64>>) {
     let frame = Frame::new(model, curve);
-    let rows = columns::rows(&COLUMNS, &frame, &curve.points);
-    (columns::names(&COLUMNS), rows)
+    let mut rows = columns::rows(&COLUMNS, &frame, &curve.points);
+    let noise = noise_columns(curve);
+    for (r, n) in rows
+        .iter_mut()
+        .zip(columns::rows(noise, &frame, &curve.points))
+    {
+        r.extend(n);
+    }
+    let mut names = columns::names(&COLUMNS);
+    names.extend(columns::names(noise));
+    (names, rows)
 }
 
 impl Datasets for FmRequest {

@@ -39,6 +39,7 @@ use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
 use crate::analysis::lock_in_noise::{lock_in_noise, LockInNoise, ThermalLockIn};
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
+use crate::analysis::orbit_noise::{grazing, NOISE_GRAZING};
 use crate::analysis::progress::Progress;
 pub use crate::analysis::settle::Found;
 use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
@@ -650,18 +651,12 @@ pub(crate) fn finish_curve(
     })
 }
 
-/// Within how many of the free lever's thermal standard deviations √(k_BT c_s) of the surface
-/// (c_s its static compliance at the tip) an orbit's lowest point may pass, above it or inside
-/// it, before the noise changes its contacts from period to period: the lock-in's noise of
-/// such a point is beyond the linear response (`curve_noise` warns).
-const NOISE_GRAZING: f64 = 5.0;
-
 /// The lock-in's thermal noise of [`SteppedSpec::noise`] at each point of the two sweeps:
 /// [`LockInNoise::NONE`] at a point that is not a stable period-1 orbit (time-averaged,
 /// on an invariant circle, unstable or of a longer period).
 ///
 /// Warns in `warnings` of the points whose lowest point passes within [`NOISE_GRAZING`]
-/// thermal standard deviations of the surface.
+/// thermal standard deviations of the surface ([`grazing`]).
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `progress` is cancelled; as [`lock_in_noise`].
@@ -674,13 +669,8 @@ fn curve_noise(
     let Some(n) = spec.noise else {
         return Ok(None);
     };
-    let model = CantileverModel::new(&spec.base)?;
-    let sigma = (n.kt * crate::analysis::peakforce::static_compliance(&model)).sqrt();
-    let offset = spec.base.contact_law.distance_offset();
-    let near = (sweeps.iter().flat_map(|s| s.iter()))
-        .filter(|p| p.noise_orbit())
-        .filter(|p| (p.observables.min_distance - offset).abs() < NOISE_GRAZING * sigma)
-        .count();
+    let orbits = (sweeps.iter().flat_map(|s| s.iter())).filter(|p| p.noise_orbit());
+    let near = grazing(&spec.base, n.kt, orbits.map(|p| p.observables.min_distance))?;
     if near > 0 {
         warnings.push(warning!(
             "thermal.noise-grazing",

@@ -44,6 +44,23 @@ pub(crate) fn fm(
         table.iter().filter(|r| r[k("stable")] == 0.0).count(),
         document["folds"].as_array().map_or(0, Vec::len),
     ));
+    if let (Some(t), Some(i)) = (
+        document["thermal"]["temperature"].as_f64(),
+        columns.iter().position(|c| *c == "frequency_shift_noise"),
+    ) {
+        let sigma: Vec<f64> = table.iter().map(|r| r[i]).collect();
+        p.line(format!(
+            "thermal noise at {t} K, loop bandwidth {}: σ(Δf) from {} to {}",
+            text.value(
+                document["thermal"]["bandwidth"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                "Hz"
+            ),
+            value(sigma.iter().copied().fold(f64::NAN, f64::min), "Hz", "Ω"),
+            value(sigma.iter().copied().fold(f64::NAN, f64::max), "Hz", "Ω"),
+        ));
+    }
     if to.files == Files::None {
         return p;
     }
