@@ -547,6 +547,31 @@ fn thermal_block(
              in a simulated tap on polystyrene, crate::analysis::peakforce::tap_noise)"
         ));
     }
+    // the thermally driven run against the linear response, beyond its standard errors and
+    // MAX_LINEAR_NOISE of itself (wider only at a flat peak, whose narrower maxima are said)
+    let off = |linear: f64, [sim, se]: [f64; 2]| {
+        let beyond = (linear - sim).abs() > 4.0 * se + MAX_LINEAR_NOISE * sim;
+        beyond && (!n.flat_peak || sim > linear)
+    };
+    let disagrees = (r.simulated.as_ref())
+        .filter(|s| off(n.peak_force, s.peak_force) || off(n.deformation, s.deformation));
+    if let Some(s) = disagrees {
+        let (f, l) = if u.si { ("N", "m") } else { ("F", "g0") };
+        let shown = |v: f64, k: f64, unit: &str| format!("{} {unit}", crate::error::number(v * k));
+        warnings.push(warning!(
+            "thermal.linear-disagrees",
+            "Read the simulated block: it measures the taps the noise makes.",
+            "the linear response's σ (peak force {}, deformation {}) differs from the thermally \
+             driven run's ({} ± {}, {} ± {}) by more than 4 standard errors and 10 %: the noise \
+             moves this tap beyond its linearisation (a jump to contact, a grazing)",
+            shown(n.peak_force, u.force, f),
+            shown(n.deformation, u.length, l),
+            shown(s.peak_force[0], u.force, f),
+            shown(s.peak_force[1], u.force, f),
+            shown(s.deformation[0], u.length, l),
+            shown(s.deformation[1], u.length, l),
+        ));
+    }
     let simulated = r.simulated.as_ref().map(|s| {
         let scaled = |v: &[f64], k: f64| v.iter().map(|x| x * k).collect::<Vec<_>>();
         json!({
