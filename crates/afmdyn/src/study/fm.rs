@@ -25,10 +25,7 @@ impl Analysis for FmRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
         crate::request::curves::check_single_frequency(&model.params, "fm")?;
         let spec = self.spec(model)?;
-        let noise = self
-            .temperature
-            .map(|_| gains(self, model, &spec))
-            .transpose()?;
+        let noise = gains(self, model, &spec)?;
         let mut curve = fm_curve(&spec, progress)?;
         if let Some((gains, kt)) = noise {
             curve_noise(&spec.base, &mut curve, &gains, kt)?;
@@ -55,7 +52,8 @@ impl Analysis for FmRequest {
     }
 }
 
-/// The loops' gains of `request`'s bandwidth (its default: [`LoopSpec::new`]) and k_B T.
+/// The loops' gains of `request`'s bandwidth (its default: [`LoopSpec::new`]) and k_B T, with
+/// a temperature (`None` without).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `bandwidth` above the lever's (a gain π/Q_K per cycle) or
@@ -64,9 +62,11 @@ fn gains(
     request: &FmRequest,
     model: &Resolved,
     spec: &FmSpec,
-) -> Result<(LoopSpec, f64), SimError> {
+) -> Result<Option<(LoopSpec, f64)>, SimError> {
     let needs = [("bandwidth", request.bandwidth)];
-    let kt = crate::request::limits::optional_kt(request.temperature, &needs, model)?;
+    let Some(kt) = crate::request::limits::optional_kt(request.temperature, &needs, model)? else {
+        return Ok(None);
+    };
     let r = fm_reference(&spec.base, spec.mode, spec.amplitude)?;
     let mut gains = LoopSpec::new(r.quality_factor);
     if let Some(b) = request.bandwidth {
@@ -79,7 +79,7 @@ fn gains(
         crate::error::within("bandwidth", b, ..=most, why)?;
         (gains.phase_gain, gains.amplitude_gain) = (loop_gain(b, f_k), loop_gain(b, f_k));
     }
-    Ok((gains, kt.expect("called with a temperature")))
+    Ok(Some((gains, kt)))
 }
 
 /// What an FM point's columns ([`COLUMNS`]) are read through: the document's units, Hz per
@@ -176,6 +176,11 @@ fn noise_columns(curve: &FmCurve) -> &'static [Column<Frame, FmPoint>] {
 /// lists, and with a probe the spring constant's), `method`, `warnings`.
 pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
     let frame = Frame::new(model, curve);
+    // the loops' gains and k_B T as the run had them (admitted: no error here)
+    let noise = (request.spec(model))
+        .and_then(|s| gains(request, model, &s))
+        .ok()
+        .flatten();
     let (u, hz, r) = (frame.u, frame.hz, &curve.reference);
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
     let spring_constant = r.stiffness * u.force / u.length;
@@ -201,22 +206,25 @@ pub(crate) fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -
         "amplitude": curve.amplitude * u.length,
         "spring_constant": spring_constant,
         "resonance_frequency": r.omega * hz,
-        "thermal": thermal(request, model, curve),
+        "thermal": thermal(request, noise, model, curve),
         "units": units,
         "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/tutorials/fm.md)",
-        "warnings": warnings(request, model, &frame, curve),
+        "warnings": warnings(request, noise, model, (&frame, curve)),
     })
 }
 
 /// The `"thermal"` block of an FM curve with a temperature (`null` without): `temperature`
 /// (K), the loops' `bandwidth` (Hz, [`loop_bandwidth`]) and `gain` per cycle, and the
 /// `method`; σ of each point in the curve's [`NOISE_COLUMNS`].
-fn thermal(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
-    let Some(t) = request.temperature else {
+fn thermal(
+    request: &FmRequest,
+    noise: Option<(LoopSpec, f64)>,
+    model: &Resolved,
+    curve: &FmCurve,
+) -> Value {
+    let (Some(t), Some((gains, _))) = (request.temperature, noise) else {
         return Value::Null;
     };
-    let spec = request.spec(model).expect("admitted");
-    let (gains, _) = gains(request, model, &spec).expect("admitted");
     let hz = model.units(true).hz_per_omega.unwrap_or(1.0);
     json!({
         "temperature": t,
@@ -228,8 +236,14 @@ fn thermal(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
 }
 
 /// The warnings of an FM curve's document: an amplitude outside the probe's typical range, ends
-/// given the wrong way round, a steady state not found.
-fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurve) -> Vec<String> {
+/// given the wrong way round, a steady state not found; with `noise` (the loops' gains and
+/// k_B T), the temperature's, points too near grazing for the linear response, an unstable loop.
+fn warnings(
+    request: &FmRequest,
+    noise: Option<(LoopSpec, f64)>,
+    model: &Resolved,
+    (frame, curve): (&Frame, &FmCurve),
+) -> Vec<String> {
     let mut warnings: Vec<String> = Vec::new();
     let unit = if model.probe.is_some() { "m" } else { "g0" };
     if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
@@ -256,12 +270,10 @@ fn warnings(request: &FmRequest, model: &Resolved, frame: &Frame, curve: &FmCurv
             ));
         }
     }
-    if let Some(t) = request.temperature {
+    if let (Some(t), Some((_, kt))) = (request.temperature, noise) {
         warnings.extend(crate::request::limits::temperature_warnings(t));
-        let kt = crate::request::limits::thermal_kt(t, model).expect("admitted");
         let lowest = curve.points.iter().map(|q| q.observables.min_distance);
-        let near = grazing(&model.params, kt, lowest).expect("admitted");
-        if near > 0 {
+        if let Ok(near @ 1..) = grazing(&model.params, kt, lowest) {
             warnings.push(warning!(
                 "fm.noise-grazing",
                 "Read their frequency_shift_noise as an estimate only.",
