@@ -267,7 +267,7 @@ pub struct FmFlags {
     #[arg(long, default_value = "1e-9", allow_negative_numbers = true, help = "Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).")]
     pub tolerance: f64,
     /// `--bandwidth`: the request's `bandwidth`.
-    #[arg(long, allow_hyphen_values = true, help = "The loops' equivalent noise bandwidth B (Hz; with --temperature), > 0 and at most ≈ π f_K/(4Q_K) (a gain π/Q_K per cycle, where they would outrun the lever); not given: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K). With --probe a unit may follow (300kHz).")]
+    #[arg(long, allow_hyphen_values = true, help = "The loops' equivalent noise bandwidth B (Hz; with --temperature), > 0 and at most ≈ π f_K/(4Q_K) (a gain min(π/Q_K, 1) per cycle, where they would outrun the lever); not given: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K). With --probe a unit may follow (300kHz).")]
     pub bandwidth: Option<Quantity>,
     /// `--temperature`: the request's `temperature`.
     #[arg(long, allow_negative_numbers = true, help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one every point gains σ of the frequency shift and of the excitation that the loops read under the lever's thermal force, by linear response of the closed loop, and the document a \"thermal\" block. Needs the probe's SI units; laws with memory are refused.")]

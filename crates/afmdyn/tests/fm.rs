@@ -365,4 +365,16 @@ fn a_temperature_gives_the_frequency_shift_noise() {
         fast.contains("bandwidth") && fast.contains("outruns"),
         "{fast}"
     );
+    // below Q = π/2 the gain's bound is 1 per cycle (π/Q would pass 2, where a first-order loop
+    // diverges, and once gave a negative largest bandwidth that refused every one)
+    let text = PROBE.replace("quality_factor = 1e4", "quality_factor = 1.2");
+    let probe = Probe::parse(&text, "q1.2").unwrap();
+    let low = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let r = serde_json::json!({"temperature": 295.0, "bandwidth": 100.0, "points": 2});
+    let r = named::parse("fm", r).unwrap().unwrap();
+    let doc = r.run(&low, &Default::default()).unwrap().document;
+    assert!((doc["thermal"]["bandwidth"].as_f64().unwrap() / 100.0 - 1.0).abs() < 1e-12);
 }

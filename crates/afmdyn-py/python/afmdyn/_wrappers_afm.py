@@ -611,8 +611,8 @@ def fm(
         amplitude: The first-harmonic amplitude A the amplitude controller holds (m with a
             probe, else g₀), > 0; default the probe's free amplitude A₀ (1 g₀).
         bandwidth: The loops' equivalent noise bandwidth B (Hz; with ``temperature``), > 0
-            and at most ≈ π f_K/(4Q_K) (a gain π/Q_K per cycle, where they would outrun the
-            lever); ``None``: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K)
+            and at most ≈ π f_K/(4Q_K) (a gain min(π/Q_K, 1) per cycle, where they would
+            outrun the lever); ``None``: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K)
             (``analysis::fm_loop::LoopSpec``).
         from_: First z_c of the approach (default: where the frequency shift has decayed to
             0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower

@@ -3,7 +3,7 @@
 //! (z_c and A in m, Δf in Hz, E_dis in J, forces in N); without one the model's units
 //! (g₀, Ω, F̃).
 
-use crate::analysis::fm::noise::{curve_noise, loop_bandwidth, loop_gain};
+use crate::analysis::fm::noise::{curve_noise, loop_bandwidth, loop_gain, MAX_LOOP_GAIN};
 use crate::analysis::fm::{fm_curve, fm_reference, FmCurve, FmPoint, FmReference, FmSpec};
 use crate::analysis::fm_loop::LoopSpec;
 use crate::analysis::orbit_noise::{grazing, NOISE_GRAZING};
@@ -15,6 +15,7 @@ use crate::request::fm::FmRequest;
 use crate::request::run::{Analysis, Resolved};
 use crate::study::named::{Arrays, Datasets};
 use serde_json::{json, Value};
+use std::f64::consts::PI;
 
 impl Analysis for FmRequest {
     type Output = FmCurve;
@@ -71,9 +72,10 @@ fn gains(
     let mut gains = LoopSpec::new(r.quality_factor);
     if let Some(b) = request.bandwidth {
         let f_k = r.omega * model.units(true).hz_per_omega.unwrap_or(1.0);
-        let most = loop_bandwidth(std::f64::consts::PI / r.quality_factor, f_k);
+        let most = loop_bandwidth(MAX_LOOP_GAIN.min(PI / r.quality_factor), f_k);
         let why = format!(
-            "must be at most {} Hz here, π f_K/(4Q_K): a faster loop outruns the lever",
+            "must be at most {} Hz here, a gain of min(π/Q_K, 1) per cycle: a faster loop \
+             outruns the lever",
             crate::error::number(most)
         );
         crate::error::within("bandwidth", b, ..=most, why)?;

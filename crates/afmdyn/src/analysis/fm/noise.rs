@@ -20,7 +20,8 @@
 //! σ_Ω and σ_α2 at the start of a cycle, where the instrument reads them.
 //!
 //! **The bandwidth.** The PLL is a first-order loop of pole 1 − g at one update per cycle: its
-//! equivalent noise bandwidth is B = f g / (2(2 − g)), f = Ω/2π the update rate. For a free
+//! equivalent noise bandwidth is B = f g / (2(2 − g)), f = Ω/2π the update rate (white input of
+//! one-sided density 2σ²/f gives the output variance σ² Σ_k g²(1 − g)^{2k} = σ² g/(2 − g)). For a free
 //! lever and a loop slow against the lever (g ≪ π/Q) the chain reduces to Albrecht's thermal
 //! frequency noise, σ_f² = f₀ k_BT B / (π k Q A²) (T. R. Albrecht, P. Grütter, D. Horne and
 //! D. Rugar, *J. Appl. Phys.* 69 (1991) 668, eq. 11; the test
@@ -57,6 +58,11 @@ pub struct FmNoise {
     /// σ_α2, the excitation's.
     pub excitation: f64,
 }
+
+/// The largest gain per cycle of the loops: a first-order loop of pole 1 − g settles in one
+/// cycle at g = 1 and overshoots beyond (and diverges at g = 2); below it, π/Q_K bounds it
+/// where the lever answers more slowly ([`crate::analysis::fm_loop`]).
+pub const MAX_LOOP_GAIN: f64 = 1.0;
 
 /// The equivalent noise bandwidth of the PLL of gain `g` per cycle at the update rate `rate`,
 /// in the rate's unit (module docs).
