@@ -78,10 +78,9 @@ STRUCTS: Dict[str, Dict[str, object]] = {
     "BimodalFlags": {
         "schema": "approach",
         "flatten": {"curve": "CurveFlags"},
-        "order": ["setpoint", "average", "exact"],
-        # the lock-in's thermal noise is computed under one harmonic drive
-        "omit": ["temperature", "time_constant"],
-        "args": {"setpoint": 'value_name = "RATIO"', "exact": 'conflicts_with = "average"'},
+        "order": ["setpoint", "average", "exact", "temperature", "time_constant"],
+        "args": {"setpoint": 'value_name = "RATIO"', "exact": 'conflicts_with = "average"',
+                 "temperature": 'value_name = "K"', "time_constant": 'value_name = "S"'},
     },
     "ResonanceFlags": {
         "schema": "resonance",

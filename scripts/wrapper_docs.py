@@ -130,7 +130,10 @@ the free amplitudes); ``setpoint`` is A1/A01 of the first component, and
 ``ds.afmdyn.to_dict()["setpoint"]["points"]`` gives every component's ``amplitude_i``,
 ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` there. With ``exact``, points
 otherwise measured on invariant circles are per point in
-``ds.afmdyn.to_dict()["invariant_circle"]``.""",
+``ds.afmdyn.to_dict()["invariant_circle"]``. With ``temperature`` every exact orbit gains
+each component's lock-in noise: ``amplitude_noise`` and ``phase_noise_deg`` (the first
+component's), ``amplitude_noise_i`` and ``phase_noise_i_deg`` (component i ≥ 2), by linear
+response over the common period (``afmdyn.approach``'s ``"thermal"`` block).""",
         "raises": """\
 Raises:
     ValueError: for a single-frequency drive (naming ``[drive].free_amplitude``), and as

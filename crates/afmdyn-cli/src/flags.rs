@@ -59,7 +59,7 @@ pub struct ApproachFlags {
     #[arg(long, allow_negative_numbers = true, value_name = "RATIO", help = "The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive A₁/A₀₁, of the first component, the one the feedback holds): the document gains a \"setpoint\" block with the operating points where the curve's amplitude equals it on each stable branch.")]
     pub setpoint: Option<f64>,
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: at every stable period-1 point of both sweeps the standard deviations of the lock-in's amplitude and phase under the lever's thermal force, by linear response about the orbit, noise within each period, switchings and the lock-in's filter included. Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) and a multifrequency drive are refused.")]
+    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: at every stable period-1 point of both sweeps the standard deviations of the lock-in's amplitude and phase under the lever's thermal force, by linear response about the orbit, noise within each period, switchings and the lock-in's filter included; under a multifrequency drive (bimodal) each component's lock-in's too, on the exact orbits of the common period (none on time averages or invariant circles). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) are refused.")]
     pub temperature: Option<f64>,
     /// `--time-constant`: the request's `time_constant`.
     #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant τ_L (s; with --temperature), ≥ 0 and at most 1 000 s; not given: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).")]
@@ -97,6 +97,12 @@ pub struct BimodalFlags {
     /// `--exact`: the request's `exact`.
     #[arg(long, conflicts_with = "average", help = "Measure every point on the exact periodic orbit of the drive's common period even where a two-frequency drive repeats only after more than 32 drive periods, whose points are otherwise measured on invariant circles (with branches and folds).")]
     pub exact: bool,
+    /// `--temperature`: the request's `temperature`.
+    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no noise. With one the document gains a \"thermal\" block: at every stable period-1 point of both sweeps the standard deviations of the lock-in's amplitude and phase under the lever's thermal force, by linear response about the orbit, noise within each period, switchings and the lock-in's filter included; under a multifrequency drive (bimodal) each component's lock-in's too, on the exact orbits of the common period (none on time averages or invariant circles). Needs the probe's SI units; the laws with memory (JKR, capillary, SLS, impact) are refused.")]
+    pub temperature: Option<f64>,
+    /// `--time-constant`: the request's `time_constant`.
+    #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant τ_L (s; with --temperature), ≥ 0 and at most 1 000 s; not given: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).")]
+    pub time_constant: Option<f64>,
     /// The flags of the nested `curve`.
     #[command(flatten)]
     pub curve: CurveFlags,
@@ -113,7 +119,8 @@ impl BimodalFlags {
             curve: self.curve.request(si, Dim::Length)?,
             exact: self.exact,
             setpoint: self.setpoint,
-            ..ApproachRequest::default()
+            temperature: self.temperature,
+            time_constant: self.time_constant,
         })
     }
 }

@@ -36,6 +36,26 @@ def test_bimodal_equals_the_command_line_and_reports_each_component(cli_json):
     assert np.isfinite(ds.energy_dissipated_2.values).all()
 
 
+def test_bimodal_temperature_gives_each_components_lock_in_noise(cli_json):
+    """With ``temperature`` the dataset carries each component's lock-in noise over (sweep, z_c)
+    in SI, equal to the command line's; far from the sample the second mode's σ_A is its own
+    (k_BT/k₂ · τ₂/(τ₂ + τ_L))^½ (k₂ = 1571 N/m, τ₂ = 2Q₂/ω₂ = τ_L·4 at the default τ_L), to 1 %."""
+    doc = cli_json("bimodal", "--probe", BIM, "--points", "4", "--no-branches", "--files",
+                   "none", "--temperature", "295")
+    ds = afmdyn.bimodal(probe=BIM, points=4, branches=False, temperature=295.0)
+    assert afmdyn.summary(ds) == doc
+    for name, unit in (("amplitude_noise_2", "m"), ("phase_noise_2_deg", "degree"),
+                       ("amplitude_noise", "m")):
+        assert ds[name].dims == ("sweep", "z_c")
+        assert ds[name].attrs["units"] == unit, name
+        # null in the document (a point averaged for lack of a short period), NaN here
+        cli = np.array(doc["approach"][name], dtype=float)
+        np.testing.assert_array_equal(ds[name].sel(sweep="approach").values, cli)
+    free = (1.380649e-23 * 295.0 / 1571.0 * 0.8) ** 0.5
+    far = ds.sel(sweep="approach").isel(z_c=0)
+    assert float(far.amplitude_noise_2) == pytest.approx(free, rel=0.01)
+
+
 def test_bimodal_refuses_a_single_frequency_drive():
     with pytest.raises(ValueError, match=r"\[drive\]\.free_amplitude"):
         afmdyn.bimodal(probe=SINGLE, points=3, branches=False)

@@ -142,6 +142,9 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
     ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM]),
     ("bimodal", ["--points", 2, "--files", "none", "--average", "--probe", BIM]),
+    # each component's lock-in noise, in the sweeps and at the operating points
+    ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM, "--temperature", 295,
+                 "--setpoint", 0.8]),
     ("image", IMAGE),
     ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),

@@ -709,6 +709,20 @@ impl Params {
             .sum()
     }
 
+    /// The drive's components as a lock-in demodulates each: (ω_c, ψ_c), the frequency (per τ)
+    /// and the phase of its drive ∝ sin(ω_c τ + ψ_c), the primary first (ψ of
+    /// [`Params::drive_phase`]; θ + π/2 for a further component's F̃ cos(ω_c τ + θ)). One entry
+    /// for a single-frequency drive.
+    pub(crate) fn demodulated(&self) -> Vec<(f64, f64)> {
+        let further = self.components().map(|c| {
+            let phase = c.phase + std::f64::consts::FRAC_PI_2;
+            (c.ratio() * self.omega, phase)
+        });
+        std::iter::once((self.omega, self.drive_phase()))
+            .chain(further)
+            .collect()
+    }
+
     /// d/dτ of [`Params::component_force`].
     pub(crate) fn component_force_rate(&self, tau: f64) -> f64 {
         self.components()

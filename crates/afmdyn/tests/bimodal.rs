@@ -415,3 +415,81 @@ fn a_long_common_period_is_warned_of() {
     let natural = beam.scales.frequency_hz(free.omega[1]);
     assert!((f2 / natural - 1.0).abs() <= 1e-6, "{f2} vs {natural}");
 }
+
+/// `bimodal` with a temperature (examples/probe-bimodal.toml: modes of 40 and 1571 N/m at
+/// 300 kHz and 1.875 MHz = 25/4 f₁, Q = 400 and 2500): every exact orbit of both sweeps gains
+/// each component's lock-in noise, `amplitude_noise`/`phase_noise_deg` (the first's) and
+/// `amplitude_noise_2`/`phase_noise_2_deg`, listed in the `"thermal"` and `"drive_components"`
+/// blocks. Far from the sample each mode is free and at its resonance with Q ≫ 1, so each
+/// lock-in reads its own mode's σ_A² = (k_BT/k_j) τ_j/(τ_j + τ_L), τ_j = 2Q_j/ω_j (the slow
+/// amplitude's response behind the lock-in's filter; equipartition at τ_L → 0): within 1 %,
+/// and σ_φ = σ_A/A_j. Measured on time averages instead, the points have no noise, and say so.
+#[test]
+fn a_temperature_gives_each_components_lock_in_noise() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::{run, ApproachRequest, Bimodal, CurveRequest, Resolved};
+    let text = include_str!("../../../examples/probe-bimodal.toml");
+    let probe = Probe::parse(text, "bimodal").expect("example probe");
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe.clone()),
+    };
+    let hot = |average: bool| {
+        Bimodal(ApproachRequest {
+            curve: CurveRequest {
+                points: Some(6),
+                branches: false,
+                ..CurveRequest::default()
+            },
+            temperature: Some(295.0),
+            average,
+            ..ApproachRequest::default()
+        })
+    };
+    let doc = run(&hot(false), &model, &Progress::new()).unwrap().json;
+    let columns = [
+        "amplitude_noise",
+        "phase_noise_deg",
+        "amplitude_noise_2",
+        "phase_noise_2_deg",
+    ];
+    assert_eq!(doc["thermal"]["columns"], serde_json::json!(columns));
+    let listed = doc["drive_components"]["columns"].to_string();
+    assert!(listed.contains("amplitude_noise_2") && listed.contains("phase_noise_2_deg"));
+    let tl = doc["thermal"]["time_constant"].as_f64().unwrap();
+    let kt = 1.380_649e-23 * 295.0;
+    let sweep = &doc["approach"];
+    let at = |key: &str| sweep[key][0].as_f64().unwrap();
+    for (j, (k, q, f)) in [(40.0, 400.0, 300e3), (1571.0, 2500.0, 1.875e6)]
+        .into_iter()
+        .enumerate()
+    {
+        let tau = 2.0 * q / (std::f64::consts::TAU * f);
+        let free = (kt / k * tau / (tau + tl)).sqrt();
+        let name = |what: &str| match j {
+            0 => format!("{what}_noise{}", if what == "phase" { "_deg" } else { "" }),
+            _ => format!(
+                "{what}_noise_2{}",
+                if what == "phase" { "_deg" } else { "" }
+            ),
+        };
+        let sigma = at(&name("amplitude"));
+        eprintln!("mode {}: σ_A = {sigma:e} m (closed form {free:e})", j + 1);
+        assert!((sigma / free - 1.0).abs() < 0.01, "{sigma} vs {free}");
+        let a = at(&format!("amplitude_{}", j + 1));
+        let phase = at(&name("phase")).to_radians();
+        assert!((phase * a / free - 1.0).abs() < 0.01, "{phase} {a} {free}");
+        for sweep in ["approach", "retract"] {
+            assert_eq!(doc[sweep][name("amplitude")].as_array().unwrap().len(), 6);
+        }
+    }
+    // time averages have no orbit to take the noise about: null, and said
+    let doc = run(&hot(true), &model, &Progress::new()).unwrap().json;
+    assert!(doc["approach"]["amplitude_noise_2"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|v| v.is_null()));
+    let said = doc["warnings"].to_string();
+    assert!(said.contains("12 point(s) are time averages"), "{said}");
+}

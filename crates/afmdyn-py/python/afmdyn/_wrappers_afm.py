@@ -186,8 +186,10 @@ def approach(
             sweeps the standard deviations of the lock-in's amplitude and phase under the
             lever's thermal force, by linear response about the orbit, noise within each
             period, switchings and the lock-in's filter included
-            (``analysis::lock_in_noise``). Needs the probe's SI units; the laws with memory
-            (JKR, capillary, SLS, impact) and a multifrequency drive are refused.
+            (``analysis::lock_in_noise``); under a multifrequency drive (bimodal) each
+            component's lock-in's too, on the exact orbits of the common period (none on
+            time averages or invariant circles). Needs the probe's SI units; the laws with
+            memory (JKR, capillary, SLS, impact) are refused.
         time_constant: The lock-in's low-pass time constant τ_L (s; with ``temperature``), ≥
             0 and at most 1 000 s; ``None``: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time
             (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).
@@ -293,6 +295,8 @@ def bimodal(
     points: Optional[int] = None,
     setpoint: Optional[float] = None,
     step: Optional[float] = None,
+    temperature: Optional[float] = None,
+    time_constant: Optional[float] = None,
     to: Optional[float] = None,
     tolerance: float = 1e-10,
     traces: Optional[int] = None,
@@ -315,7 +319,10 @@ def bimodal(
     ``ds.afmdyn.to_dict()["setpoint"]["points"]`` gives every component's ``amplitude_i``,
     ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` there. With ``exact``, points
     otherwise measured on invariant circles are per point in
-    ``ds.afmdyn.to_dict()["invariant_circle"]``.
+    ``ds.afmdyn.to_dict()["invariant_circle"]``. With ``temperature`` every exact orbit gains
+    each component's lock-in noise: ``amplitude_noise`` and ``phase_noise_deg`` (the first
+    component's), ``amplitude_noise_i`` and ``phase_noise_i_deg`` (component i ≥ 2), by linear
+    response over the common period (``afmdyn.approach``'s ``"thermal"`` block).
 
     Args:
         average: Measure every point by the time average of a multifrequency drive
@@ -339,6 +346,19 @@ def bimodal(
             a ``"setpoint"`` block with the operating points where the curve's amplitude
             equals it on each stable branch (``analysis::setpoint``).
         step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
+        temperature: The temperature T of the thermal force (K, > 0 and ≤ 1500; outside
+            200–500 K it warns, a value in °C?); ``None`` (the default): no noise. With one
+            the document gains a ``"thermal"`` block: at every stable period-1 point of both
+            sweeps the standard deviations of the lock-in's amplitude and phase under the
+            lever's thermal force, by linear response about the orbit, noise within each
+            period, switchings and the lock-in's filter included
+            (``analysis::lock_in_noise``); under a multifrequency drive (bimodal) each
+            component's lock-in's too, on the exact orbits of the common period (none on
+            time averages or invariant circles). Needs the probe's SI units; the laws with
+            memory (JKR, capillary, SLS, impact) are refused.
+        time_constant: The lock-in's low-pass time constant τ_L (s; with ``temperature``), ≥
+            0 and at most 1 000 s; ``None``: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time
+            (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).
         to: Other end (front-end unit): z_c where the approach ends and the retract starts
             (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
         tolerance: Tolerance of the adaptive integrator, in (0, 1e-3).

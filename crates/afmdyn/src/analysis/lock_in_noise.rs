@@ -1,9 +1,10 @@
 //! The lock-in's amplitude and phase noise on a periodic orbit under the thermal force, by
 //! linear response: what an AM-AFM at that operating point measures as σ_A and σ_φ at the
-//! lock-in's bandwidth.
+//! lock-in's bandwidth, and under a multifrequency drive (bimodal AFM) what each component's
+//! lock-in measures.
 //!
-//! **The chain** (`crate::analysis::orbit_noise`): the deviation δz from the period-1 orbit, extended by
-//! the lock-in's states. The lock-in of [`super::am_loop`] is linear in W(1,τ): over a drive
+//! **The chain** (`crate::analysis::orbit_noise`): the deviation δz from the orbit, extended by
+//! the lock-ins' states. The lock-in of [`super::am_loop`] is linear in W(1,τ): over a drive
 //! period it sums X = (2/M) Σ_j W_j sin θ_j and Y = −(2/M) Σ_j W_j cos θ_j at M equal parts,
 //! then low-passes them once per period, X̄ ← X̄ + β(X − X̄), β = 1 − e^{−T/τ_L}. The deviation
 //! y = (δz, δX, δY, δX̄, δȲ) of the whole chain is then a linear system in discrete time: over
@@ -12,6 +13,15 @@
 //! From the stationary covariance Y, σ_A² = gᵀYg, σ_φ² = hᵀYh with g = (X̄, Ȳ)/A and
 //! h = (−Ȳ, X̄)/A² on (δX̄, δȲ): the gradients of A = |(X̄, Ȳ)| and φ = arg(X̄ + iȲ) at the
 //! orbit's first harmonic.
+//!
+//! **A multifrequency drive** repeats over its common period T_c = qT
+//! ([`crate::params::Params::common_periods`]): the chain is walked over T_c, with one lock-in
+//! per component c, each summing X_c, Y_c at θ_j = ω_c τ_j + ψ_c
+//! ([`crate::params::Params::demodulated`], the phases the orbit's component observables are
+//! demodulated with) over the qM samples of T_c, and low-passing them once per common period,
+//! β = 1 − e^{−T_c/τ_L} (one τ_L for every lock-in). Over a period shorter than τ_L this is the
+//! continuous filter's response to the sums of q drive periods; for q = 1 it is the lock-in
+//! above.
 //!
 //! This is the linear response of the measurement itself: the noise within a period, which
 //! reaches that period's (X, Y) directly, is in it as much as the noise carried over in δz. It
@@ -27,6 +37,7 @@ use super::orbit_noise::Walk;
 use crate::error::SimError;
 use crate::integrate::IntegratorOptions;
 use crate::model::CantileverModel;
+use crate::params::MAX_DRIVE_COMPONENTS;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -50,6 +61,16 @@ pub struct LockInNoise {
     pub amplitude: f64,
     /// σ_φ, the phase's (rad).
     pub phase: f64,
+    /// Under a multifrequency drive, (σ_A, σ_φ) (g₀, rad) of the lock-in of each further
+    /// component in the order of [`crate::params::Params::drive_components`]; NaN past the
+    /// drive's components.
+    #[serde(default = "no_further")]
+    pub further: [[f64; 2]; MAX_DRIVE_COMPONENTS],
+}
+
+/// No further components' noise.
+fn no_further() -> [[f64; 2]; MAX_DRIVE_COMPONENTS] {
+    [[f64::NAN; 2]; MAX_DRIVE_COMPONENTS]
 }
 
 impl LockInNoise {
@@ -57,17 +78,19 @@ impl LockInNoise {
     pub const NONE: LockInNoise = LockInNoise {
         amplitude: f64::NAN,
         phase: f64::NAN,
+        further: [[f64::NAN; 2]; MAX_DRIVE_COMPONENTS],
     };
 }
 
-/// The lock-in's noise (module docs) on the period-1 orbit of `model` through `z` at τ = 0,
-/// under the thermal energy `kt` (k_B T in the model's energy unit), with the lock-in's
-/// `samples` per period and time constant `time_constant` (τ_L ≥ 0, units of τ).
+/// The lock-ins' noise (module docs) on the periodic orbit of `model` through `z` at τ = 0 (its
+/// common period under a multifrequency drive), under the thermal energy `kt` (k_B T in the
+/// model's energy unit), with the lock-in's `samples` per drive period and time constant
+/// `time_constant` (τ_L ≥ 0, units of τ).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `samples` (0), `kt` or `time_constant` (negative or not
-/// finite); [`SimError::Unsupported`] for a law with memory ([`crate::integrate::exact::noise::admits_model`]); the integrator's and
-/// the flow's errors; [`SimError::OutOfRange`] naming `drive` for a multifrequency drive.
+/// finite); [`SimError::Unsupported`] for a law with memory
+/// ([`crate::integrate::exact::noise::admits`]); the integrator's and the flow's errors.
 pub fn lock_in_noise(
     model: &CantileverModel,
     z: &DVector<f64>,
@@ -83,58 +106,70 @@ pub fn lock_in_noise(
             "must be a finite number ≥ 0",
         ));
     }
-    let (chain, harmonic) = period_chain(model, z, kt, time_constant, samples)?;
+    let (chain, harmonics) = period_chain(model, z, kt, time_constant, samples)?;
     let Some(y) = chain.stationary() else {
         return Ok(LockInNoise::NONE);
     };
-    let (x, yy) = harmonic;
-    let a = x.hypot(yy);
     let n = chain.f.nrows();
-    let form = |g: [f64; 2]| {
-        let mut v = DVector::zeros(n);
-        (v[n - 2], v[n - 1]) = (g[0], g[1]);
-        v.dot(&(&y * &v)).max(0.0).sqrt()
+    let dim = n - 4 * harmonics.len();
+    // σ of lock-in c's (A, φ): the forms g, h on its (δX̄, δȲ)
+    let sigma = |c: usize, (x, yy): (f64, f64)| {
+        let a = x.hypot(yy);
+        let form = |g: [f64; 2]| {
+            let mut v = DVector::zeros(n);
+            (v[dim + 4 * c + 2], v[dim + 4 * c + 3]) = (g[0], g[1]);
+            v.dot(&(&y * &v)).max(0.0).sqrt()
+        };
+        [form([x / a, yy / a]), form([-yy / (a * a), x / (a * a)])]
     };
-    Ok(LockInNoise {
-        amplitude: form([x / a, yy / a]),
-        phase: form([-yy / (a * a), x / (a * a)]),
-    })
+    let mut out = LockInNoise::NONE;
+    for (c, &h) in harmonics.iter().enumerate() {
+        match c {
+            0 => [out.amplitude, out.phase] = sigma(0, h),
+            _ => out.further[c - 1] = sigma(c, h),
+        }
+    }
+    Ok(out)
 }
 
-/// The chain of the orbit through (0, `z`) over one period, the lock-in's four states X, Y, X̄,
-/// Ȳ after the deviation, and the orbit's first harmonic (X, Y).
+/// The chain of the orbit through (0, `z`) over one (common) period, each lock-in's four
+/// states X_c, Y_c, X̄_c, Ȳ_c after the deviation (at dim + 4c..), and the orbit's first
+/// harmonic (X_c, Y_c) at each component (module docs; one for a single-frequency drive).
 pub(crate) fn period_chain(
     model: &CantileverModel,
     z: &DVector<f64>,
     kt: f64,
     time_constant: f64,
     samples: usize,
-) -> Result<(super::orbit_noise::Chain, (f64, f64)), SimError> {
+) -> Result<(super::orbit_noise::Chain, Vec<(f64, f64)>), SimError> {
+    let references = model.params().demodulated();
     let dim = z.len();
-    let n = dim + 4;
-    let (ix, iy, ixb, iyb) = (dim, dim + 1, dim + 2, dim + 3);
-    let p = model.params();
+    let n = dim + 4 * references.len();
     let period = model.period();
-    let mut walk = Walk::new(model, z, kt, 4, IntegratorOptions::default())?;
+    let mut walk = Walk::new(model, z, kt, n - dim, IntegratorOptions::default())?;
     let mut tip = DVector::zeros(dim);
     tip.rows_mut(0, model.modes()).copy_from(model.tip());
-    let (mut x, mut y) = (0.0, 0.0);
-    let parts = samples * SUBSTEPS;
+    let mut harmonics = vec![(0.0, 0.0); references.len()];
+    // samples per drive period, over the q drive periods of the common period
+    let count = samples * model.params().common_periods() as usize;
+    let (parts, scale) = (count * SUBSTEPS, 2.0 / count as f64);
     let mut m = DMatrix::identity(n, n);
     for k in 1..=parts {
         let t1 = period * k as f64 / parts as f64;
         walk.part(t1)?;
         if k % SUBSTEPS == 0 {
-            // the lock-in's sample j = k / SUBSTEPS at θ_j = Ωτ_j + ψ
-            let (s, c) = (p.omega * t1 + p.drive_phase()).sin_cos();
+            // the lock-ins' sample j = k / SUBSTEPS at θ_j = ω_c τ_j + ψ_c
             let wt = tip.dot(&walk.state);
-            let scale = 2.0 / samples as f64;
-            x += scale * wt * s;
-            y -= scale * wt * c;
             m.fill_with_identity();
-            for j in 0..dim {
-                m[(ix, j)] = scale * s * tip[j];
-                m[(iy, j)] = -scale * c * tip[j];
+            for (c, &(omega, psi)) in references.iter().enumerate() {
+                let (s, co) = (omega * t1 + psi).sin_cos();
+                harmonics[c].0 += scale * wt * s;
+                harmonics[c].1 -= scale * wt * co;
+                let (ix, iy) = (dim + 4 * c, dim + 4 * c + 1);
+                for j in 0..dim {
+                    m[(ix, j)] = scale * s * tip[j];
+                    m[(iy, j)] = -scale * co * tip[j];
+                }
             }
             walk.chain.apply(&m);
         }
@@ -142,15 +177,18 @@ pub(crate) fn period_chain(
     // the period's end: X̄ ← (1 − β) X̄ + β X, then the sums start again
     let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period);
     m.fill_with_identity();
-    for (i, from) in [(ixb, ix), (iyb, iy)] {
-        m[(i, i)] = 1.0 - beta;
-        m[(i, from)] = beta;
-    }
-    for i in [ix, iy] {
-        m[(i, i)] = 0.0;
+    for c in 0..references.len() {
+        let (ix, iy) = (dim + 4 * c, dim + 4 * c + 1);
+        for (i, from) in [(ix + 2, ix), (iy + 2, iy)] {
+            m[(i, i)] = 1.0 - beta;
+            m[(i, from)] = beta;
+        }
+        for i in [ix, iy] {
+            m[(i, i)] = 0.0;
+        }
     }
     walk.chain.apply(&m);
-    Ok((walk.chain, (x, y)))
+    Ok((walk.chain, harmonics))
 }
 
 #[cfg(test)]

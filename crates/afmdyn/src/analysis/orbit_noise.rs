@@ -30,7 +30,7 @@
 use crate::contact::ForceEval;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::noise::{admits_model, diffusion, linear_part, rate_of, van_loan};
+use crate::integrate::exact::noise::{admits, diffusion, linear_part, rate_of, van_loan};
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::flow::{flow, FlowMap};
 use crate::model::CantileverModel;
@@ -140,9 +140,8 @@ impl<'a> Walk<'a> {
     /// followed by `observers` states.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `kt` (negative or not finite) or `drive` (a
-    /// multifrequency drive), [`SimError::Unsupported`] for a law with memory
-    /// ([`admits_model`]); the integrator's.
+    /// [`SimError::OutOfRange`] naming `kt` (negative or not finite),
+    /// [`SimError::Unsupported`] for a law with memory ([`admits`]); the integrator's.
     pub(crate) fn new(
         model: &'a CantileverModel,
         z: &DVector<f64>,
@@ -157,7 +156,7 @@ impl<'a> Walk<'a> {
                 "must be a finite number ≥ 0",
             ));
         }
-        admits_model(model.params())?;
+        admits(&model.params().contact_law)?;
         let linear = linear_part(model)?;
         let d = [Region::Free, Region::Contact].map(|r| diffusion(&linear, r, kt));
         let n = z.len() + observers;

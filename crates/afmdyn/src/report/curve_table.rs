@@ -5,8 +5,8 @@
 //! writes the table.
 
 use super::{
-    component_columns, component_row, curve_column_index, curve_row, CurveUnits, UnitKind,
-    CURVE_COLUMNS, NOISE_COLUMNS,
+    component_columns, component_noise_columns, component_row, curve_column_index, curve_row,
+    noise_row, CurveUnits, UnitKind, CURVE_COLUMNS, NOISE_COLUMNS,
 };
 use crate::analysis::continuation::BranchEvent;
 use crate::analysis::lock_in_noise::LockInNoise;
@@ -46,9 +46,14 @@ pub(crate) fn curve_table(
     for (name, kind, what) in component_columns(count) {
         cols.push(Column::new(name, u.unit(kind), what));
     }
-    // with a temperature the lock-in's σ_A and σ_φ, after them (NaN on the branches)
-    for c in NOISE_COLUMNS.iter().filter(|_| c.noise.is_some()) {
-        cols.push(Column::new(c.name, u.unit(c.kind), c.long_name));
+    // with a temperature the lock-ins' σ_A and σ_φ, after them (NaN on the branches)
+    if c.noise.is_some() {
+        for c in NOISE_COLUMNS {
+            cols.push(Column::new(c.name, u.unit(c.kind), c.long_name));
+        }
+        for (name, kind, what) in component_noise_columns(count) {
+            cols.push(Column::new(name, u.unit(kind), what));
+        }
     }
     if dforce {
         (rows(c, x, u, base), cols)
@@ -142,10 +147,11 @@ fn row(point: &TablePoint, u: &CurveUnits) -> Vec<f64> {
 fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params) -> Vec<Vec<f64>> {
     let omega = |v: f64| base.with(c.param, v).omega;
     let mut out = Vec::new();
-    let noise = |s: Option<&LockInNoise>| match s {
-        Some(n) => vec![n.amplitude * u.length, n.phase.to_degrees()],
-        None => vec![f64::NAN; 2],
-    };
+    let count = c
+        .first
+        .first()
+        .map_or(1, |p| p.observables.components.len());
+    let noise = |s: Option<&LockInNoise>| noise_row(s, count, u).into_iter().map(|v| v.1);
     for (k, (code, sweep)) in [(0.0, &c.first), (1.0, &c.second)].into_iter().enumerate() {
         for (i, p) in sweep.iter().enumerate() {
             let point = TablePoint {

@@ -162,15 +162,15 @@ fn sweep_doc(
         u,
     );
     if let Some(n) = noise {
-        let [a, p] = NOISE_COLUMNS.map(|c| c.name);
-        m.insert(
-            a.into(),
-            json!(n.iter().map(|s| s.amplitude * u.length).collect::<Vec<_>>()),
-        );
-        m.insert(
-            p.into(),
-            json!(n.iter().map(|s| s.phase.to_degrees()).collect::<Vec<_>>()),
-        );
+        // the first component's σ_A, σ_φ, then each further component's
+        let count = points.first().map_or(1, |p| p.observables.components.len());
+        let rows: Vec<_> = n.iter().map(|s| noise_row(Some(s), count, u)).collect();
+        for (k, (name, _)) in rows.first().into_iter().flatten().enumerate() {
+            m.insert(
+                name.clone(),
+                json!(rows.iter().map(|r| r[k].1).collect::<Vec<_>>()),
+            );
+        }
     }
     m.insert(
         "period".into(),
@@ -350,6 +350,7 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
         return None;
     }
     let omega = params.with(c.param, c.first[0].value).omega;
+    let noise = c.noise.is_some();
     // Hz in SI (τ = t / u.time), else Ω units
     let freq = |r: f64| {
         if u.si {
@@ -362,8 +363,10 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
         "ratio": o.components.iter().map(|c| c.ratio).collect::<Vec<_>>(),
         "frequency": o.components.iter().map(|c| freq(c.ratio)).collect::<Vec<_>>(),
         "free_amplitude": o.components.iter().map(|c| c.free_amplitude * u.length).collect::<Vec<_>>(),
+        // with a temperature, the further components' lock-in noise too
         "columns": component_columns(o.components.len())
             .into_iter()
+            .chain(component_noise_columns(o.components.len()).into_iter().filter(|_| noise))
             .map(|(n, k, l)| json!([n, k.key(), l]))
             .collect::<Vec<_>>(),
     }))
@@ -499,7 +502,7 @@ pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Val
 /// The `"thermal"` block of `afmdyn approach --temperature T --json`
 /// ([`crate::analysis::lock_in_noise`]; the sweeps' [`NOISE_COLUMNS`] carry σ_A and σ_φ):
 /// `temperature` (K), `time_constant` (the lock-in's τ_L, in `u`'s time), `bandwidth` (its
-/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, Hz with a probe, else per
+/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, T = 1/f_d the drive's (common) period; Hz with a probe, else per
 /// unit τ) and `method`.
 pub(crate) fn thermal_noise(
     params: &Params,
@@ -515,9 +518,13 @@ pub(crate) fn thermal_noise(
         "bandwidth": 0.5 / (period * u.time) * beta / (2.0 - beta),
         "method": "the lock-in's amplitude and phase noise by linear response about each \
                    orbit: the variational flow with its saltations, the fluctuation–dissipation \
-                   theorem's white force and the lock-in's filter as one linear chain per \
-                   period, its stationary covariance (crate::analysis::lock_in_noise)",
-        "columns": NOISE_COLUMNS.iter().map(|c| c.name).collect::<Vec<_>>(),
+                   theorem's white force and the lock-in's filter (one per drive component, \
+                   over the common period) as one linear chain per period, its stationary \
+                   covariance (crate::analysis::lock_in_noise)",
+        "columns": noise_row(None, params.demodulated().len(), u)
+            .into_iter()
+            .map(|c| c.0)
+            .collect::<Vec<_>>(),
     })
 }
 
@@ -581,11 +588,11 @@ pub(crate) fn setpoint(
             for (c, v) in CURVE_COLUMNS.iter().zip(row) {
                 m.insert(c.name.into(), json!(v));
             }
-            // with a temperature: the lock-in's noise of the operating orbit
-            if let Some(n) = op.noise {
-                let [a, p] = NOISE_COLUMNS.map(|c| c.name);
-                m.insert(a.into(), json!(n.amplitude * u.length));
-                m.insert(p.into(), json!(n.phase.to_degrees()));
+            // with a temperature: the lock-ins' noise of the operating orbit
+            if let Some(n) = &op.noise {
+                for (name, v) in noise_row(Some(n), comps.len() / 4, u) {
+                    m.insert(name, json!(v));
+                }
             }
             // a multifrequency drive: each component's amplitude, phase, virial and E_dis there
             let names = component_columns(comps.len() / 4);

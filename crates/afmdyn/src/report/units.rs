@@ -307,6 +307,45 @@ pub(crate) const NOISE_COLUMNS: [CurveColumn; 2] = [
     ),
 ];
 
+/// The lock-in noise columns of a multifrequency drive's further components 2..=`count` (after
+/// [`NOISE_COLUMNS`], which are the first component's), each with its kind of unit and meaning.
+pub(crate) fn component_noise_columns(count: usize) -> Vec<(String, UnitKind, String)> {
+    let what = "under the thermal force (linear response)";
+    (2..=count)
+        .flat_map(|i| {
+            [
+                (
+                    format!("amplitude_noise_{i}"),
+                    UnitKind::Length,
+                    format!("standard deviation of component {i}'s lock-in amplitude {what}"),
+                ),
+                (
+                    format!("phase_noise_{i}_deg"),
+                    UnitKind::Phase,
+                    format!("standard deviation of component {i}'s lock-in phase {what}"),
+                ),
+            ]
+        })
+        .collect()
+}
+
+/// The names of [`NOISE_COLUMNS`] and [`component_noise_columns`] of a drive of `count`
+/// components, and their values at `noise` in `u`'s units (NaN without an estimate).
+pub(crate) fn noise_row(
+    noise: Option<&crate::analysis::lock_in_noise::LockInNoise>,
+    count: usize,
+    u: &CurveUnits,
+) -> Vec<(String, f64)> {
+    let n = noise.unwrap_or(&crate::analysis::lock_in_noise::LockInNoise::NONE);
+    let further = n.further.into_iter().take(count.saturating_sub(1));
+    let values = std::iter::once([n.amplitude, n.phase])
+        .chain(further)
+        .flat_map(|[a, p]| [a * u.length, p.to_degrees()]);
+    let names = (NOISE_COLUMNS.iter().map(|c| c.name.to_string()))
+        .chain(component_noise_columns(count).into_iter().map(|c| c.0));
+    names.zip(values).collect()
+}
+
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
 pub(crate) const CURVE_COLUMNS: [CurveColumn; 13] = [
     curve_column(

@@ -188,10 +188,13 @@ pub(crate) fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
     };
     // a point: its state, observables and orbit (a few hundred bytes)
     let point = 4.0 * state_bytes(p) + 512.0;
-    // the lock-in's thermal noise at every point of both sweeps: a period of variational flows
-    // in 512 parts and the chain's (2N + 4)² products (crate::analysis::lock_in_noise)
+    // the lock-in's thermal noise at every point of both sweeps: a (common) period of
+    // variational flows in 512 parts per drive period and the chain's products, whose size
+    // 2N + 4L with L lock-ins (one per drive component) is at most L times one lock-in's
+    // (crate::analysis::lock_in_noise)
+    let chain = (p.demodulated().len() as f64).powi(3) * p.common_periods() as f64;
     let noise = match spec.noise {
-        Some(_) => 2.0 * points * NOISE_PERIODS * p.modes as f64,
+        Some(_) => 2.0 * points * NOISE_PERIODS * p.modes as f64 * chain,
         None => 0.0,
     };
     Ok(Cost {

@@ -310,9 +310,10 @@ request! {
         /// `"thermal"` block: at every stable period-1 point of both sweeps the standard
         /// deviations of the lock-in's amplitude and phase under the lever's thermal force, by
         /// linear response about the orbit, noise within each period, switchings and the
-        /// lock-in's filter included ([`crate::analysis::lock_in_noise`]). Needs the probe's SI
-        /// units; the laws with memory (JKR, capillary, SLS, impact) and a multifrequency drive
-        /// are refused.
+        /// lock-in's filter included ([`crate::analysis::lock_in_noise`]); under a
+        /// multifrequency drive (bimodal) each component's lock-in's too, on the exact orbits of
+        /// the common period (none on time averages or invariant circles). Needs the probe's SI
+        /// units; the laws with memory (JKR, capillary, SLS, impact) are refused.
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
         /// The lock-in's low-pass time constant τ_L (s; with `temperature`), ≥ 0 and at most
@@ -355,8 +356,8 @@ impl ApproachRequest {
     /// temperature.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe), `drive`
-    /// (multifrequency) or `time_constant` (out of range, or without a temperature);
+    /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe) or
+    /// `time_constant` (out of range, or without a temperature);
     /// [`SimError::Unsupported`] for a law with memory.
     fn thermal(&self, model: &Resolved) -> Result<Option<ThermalLockIn>, SimError> {
         let needs = [("time_constant", self.time_constant)];

@@ -86,12 +86,7 @@ impl Ctx {
                 .fold(0.0f64, |m, l| m.max(l.norm()))
         });
         let components: Vec<(f64, f64)> = if p.is_multifrequency() {
-            std::iter::once((p.omega, p.drive_phase()))
-                .chain(
-                    p.components()
-                        .map(|c| (c.ratio() * p.omega, c.phase + std::f64::consts::FRAC_PI_2)),
-                )
-                .collect()
+            p.demodulated()
         } else {
             Vec::new()
         };

@@ -681,6 +681,25 @@ fn curve_noise(
              to period: their lock-in noise is beyond the linear response"
         ));
     }
+    let all = || sweeps.iter().flat_map(|s| s.iter());
+    let on_circle = |p: &&CurvePoint| p.circle.is_some() && p.fallback.is_none();
+    let averaged = |p: &&CurvePoint| p.average.is_some() || p.reached == Reached::Averaged;
+    let unmeasured = all().filter(|p| averaged(p) || on_circle(p)).count();
+    let circles = all().any(|p| on_circle(&p));
+    if unmeasured > 0 {
+        warnings.push(warning!(
+            "thermal.no-orbit",
+            "Exact orbits carry the noise: bimodal --exact instead of invariant circles, no \
+             --average (a quasi-periodic drive has none).",
+            "{unmeasured} point(s) are {} and have no lock-in noise (null): the noise is \
+             computed about exact periodic orbits only",
+            if circles {
+                "on invariant circles"
+            } else {
+                "time averages"
+            }
+        ));
+    }
     let sweep = |points: &[CurvePoint]| -> Result<Vec<LockInNoise>, SimError> {
         points
             .iter()

@@ -186,7 +186,8 @@ fn summary(p: &mut Presentation, s: &Shown<'_>) {
 }
 
 /// The line of the `"thermal"` block (an approach with a temperature): the lock-in's time
-/// constant and bandwidth, and the range of σ_A and σ_φ over the stable period-1 points.
+/// constant and bandwidth, and the range of σ_A and σ_φ over the stable period-1 points (under
+/// a multifrequency drive, of the first component; each further one's on a line of its own).
 fn thermal(p: &mut Presentation, t: &Value, s: &Shown<'_>) {
     let Some(noise) = &s.c.noise else {
         return;
@@ -216,6 +217,21 @@ fn thermal(p: &mut Presentation, t: &Value, s: &Shown<'_>) {
         s.l.show(a),
         s.l.show(b)
     ));
+    let count =
+        s.c.first
+            .first()
+            .map_or(0, |p| p.observables.components.len());
+    for i in 1..count {
+        let (a, b) = range(&|n| n.further[i - 1][0] * s.u.length);
+        let (c, d) = range(&|n| n.further[i - 1][1].to_degrees());
+        if a <= b {
+            let (a, b) = (s.l.show(a), s.l.show(b));
+            p.line(format!(
+                "    component {}: σ_A {a} to {b}, σ_φ {c:.4}° to {d:.4}°",
+                i + 1
+            ));
+        }
+    }
 }
 
 /// Below this fraction of the model's force and energy units (F̃ and F̃·g₀: kA₀ and kA₀² for
