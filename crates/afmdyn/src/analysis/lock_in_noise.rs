@@ -17,7 +17,7 @@
 //! **A multifrequency drive** repeats over its common period T_c = qT
 //! ([`crate::params::Params::common_periods`]): the chain is walked over T_c, with one lock-in
 //! per component c, each summing X_c, Y_c at θ_j = ω_c τ_j + ψ_c
-//! ([`crate::params::Params::demodulated`], the phases the orbit's component observables are
+//! (`Params::demodulated`, the phases the orbit's component observables are
 //! demodulated with) over the qM samples of T_c, and low-passing them once per common period,
 //! β = 1 − e^{−T_c/τ_L} (one τ_L for every lock-in). Over a period shorter than τ_L this is the
 //! continuous filter's response to the sums of q drive periods; for q = 1 it is the lock-in
