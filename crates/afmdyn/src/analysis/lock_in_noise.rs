@@ -16,12 +16,14 @@
 //!
 //! **A multifrequency drive** repeats over its common period T_c = qT
 //! ([`crate::params::Params::common_periods`]): the chain is walked over T_c, with one lock-in
-//! per component c, each summing X_c, Y_c at θ_j = ω_c τ_j + ψ_c
-//! (`Params::demodulated`, the phases the orbit's component observables are
-//! demodulated with) over the qM samples of T_c, and low-passing them once per common period,
-//! β = 1 − e^{−T_c/τ_L} (one τ_L for every lock-in). Over a period shorter than τ_L this is the
-//! continuous filter's response to the sums of q drive periods; for q = 1 it is the lock-in
-//! above.
+//! per component c, each the lock-in above at its own reference: summing X_c, Y_c at
+//! θ_j = ω_c τ_j + ψ_c (`Params::demodulated`, the phases the orbit's component observables
+//! are demodulated with) over each drive period T and low-passing them once per drive period,
+//! β = 1 − e^{−T/τ_L} (one τ_L for every lock-in), q times over T_c. Its bandwidth is then
+//! τ_L's, as in the single-frequency case, whatever q; the sums over a drive period holding a
+//! non-integer number of cycles of ω_c (6.25 at f₂ = 25/4 f₁) carry a ripple that the
+//! low-pass averages and that the chain, periodic over T_c, holds exactly. The forms g and h
+//! take the orbit's exact harmonic over T_c (its component amplitude and phase).
 //!
 //! This is the linear response of the measurement itself: the noise within a period, which
 //! reaches that period's (X, Y) directly, is in it as much as the noise carried over in δz. It
@@ -150,21 +152,34 @@ pub(crate) fn period_chain(
     let mut tip = DVector::zeros(dim);
     tip.rows_mut(0, model.modes()).copy_from(model.tip());
     let mut harmonics = vec![(0.0, 0.0); references.len()];
-    // samples per drive period, over the q drive periods of the common period
-    let count = samples * model.params().common_periods() as usize;
-    let (parts, scale) = (count * SUBSTEPS, 2.0 / count as f64);
+    // `samples` per drive period, over the q drive periods of the common period
+    let q = model.params().common_periods() as usize;
+    let (per_period, scale) = (samples * SUBSTEPS, 2.0 / samples as f64);
+    // each drive period's end: X̄ ← (1 − β) X̄ + β X, then the sums start again
+    let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period / q as f64);
+    let mut filter = DMatrix::identity(n, n);
+    for c in 0..references.len() {
+        let (ix, iy) = (dim + 4 * c, dim + 4 * c + 1);
+        for (i, from) in [(ix + 2, ix), (iy + 2, iy)] {
+            filter[(i, i)] = 1.0 - beta;
+            filter[(i, from)] = beta;
+        }
+        for i in [ix, iy] {
+            filter[(i, i)] = 0.0;
+        }
+    }
     let mut m = DMatrix::identity(n, n);
-    for k in 1..=parts {
-        let t1 = period * k as f64 / parts as f64;
+    for k in 1..=q * per_period {
+        let t1 = period * k as f64 / (q * per_period) as f64;
         walk.part(t1)?;
         if k % SUBSTEPS == 0 {
-            // the lock-ins' sample j = k / SUBSTEPS at θ_j = ω_c τ_j + ψ_c
+            // the lock-ins' sample at θ_j = ω_c τ_j + ψ_c; the harmonic over the common period
             let wt = tip.dot(&walk.state);
             m.fill_with_identity();
             for (c, &(omega, psi)) in references.iter().enumerate() {
                 let (s, co) = (omega * t1 + psi).sin_cos();
-                harmonics[c].0 += scale * wt * s;
-                harmonics[c].1 -= scale * wt * co;
+                harmonics[c].0 += scale / q as f64 * wt * s;
+                harmonics[c].1 -= scale / q as f64 * wt * co;
                 let (ix, iy) = (dim + 4 * c, dim + 4 * c + 1);
                 for j in 0..dim {
                     m[(ix, j)] = scale * s * tip[j];
@@ -173,21 +188,10 @@ pub(crate) fn period_chain(
             }
             walk.chain.apply(&m);
         }
-    }
-    // the period's end: X̄ ← (1 − β) X̄ + β X, then the sums start again
-    let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period);
-    m.fill_with_identity();
-    for c in 0..references.len() {
-        let (ix, iy) = (dim + 4 * c, dim + 4 * c + 1);
-        for (i, from) in [(ix + 2, ix), (iy + 2, iy)] {
-            m[(i, i)] = 1.0 - beta;
-            m[(i, from)] = beta;
-        }
-        for i in [ix, iy] {
-            m[(i, i)] = 0.0;
+        if k % per_period == 0 {
+            walk.chain.apply(&filter);
         }
     }
-    walk.chain.apply(&m);
     Ok((walk.chain, harmonics))
 }
 

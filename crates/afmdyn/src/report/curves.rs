@@ -502,7 +502,7 @@ pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Val
 /// The `"thermal"` block of `afmdyn approach --temperature T --json`
 /// ([`crate::analysis::lock_in_noise`]; the sweeps' [`NOISE_COLUMNS`] carry σ_A and σ_φ):
 /// `temperature` (K), `time_constant` (the lock-in's τ_L, in `u`'s time), `bandwidth` (its
-/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, T = 1/f_d the drive's (common) period; Hz with a probe, else per
+/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, T = 1/f_d the (first) drive's period; Hz with a probe, else per
 /// unit τ) and `method`.
 pub(crate) fn thermal_noise(
     params: &Params,
@@ -510,7 +510,8 @@ pub(crate) fn thermal_noise(
     time_constant: f64,
     u: &CurveUnits,
 ) -> Value {
-    let period = params.period();
+    // the lock-ins low-pass once per drive period (crate::analysis::lock_in_noise)
+    let period = std::f64::consts::TAU / params.omega;
     let beta = crate::analysis::am_loop::lock_in_beta(time_constant, period);
     json!({
         "temperature": temperature,

@@ -681,18 +681,6 @@ fn curve_noise(
              to period: their lock-in noise is beyond the linear response"
         ));
     }
-    let (window, q) = (spec.base.period(), spec.base.common_periods());
-    if window > n.time_constant {
-        warnings.push(warning!(
-            "thermal.long-window",
-            "A ratio p/q with a smaller q, or a time constant at least the common period, gives \
-             the lock-ins' own bandwidth.",
-            "the lock-ins sum each (common) period of {q} drive period(s) before their low-pass, \
-             and that window is {:.3}× their time constant τ_L: their bandwidth (the thermal \
-             block's) is set by the window, about 1/(2T_c), not by τ_L",
-            window / n.time_constant
-        ));
-    }
     let all = || sweeps.iter().flat_map(|s| s.iter());
     let on_circle = |p: &&CurvePoint| p.circle.is_some() && p.fallback.is_none();
     let averaged = |p: &&CurvePoint| p.average.is_some() || p.reached == Reached::Averaged;
