@@ -39,10 +39,7 @@ pub(crate) fn curve_table(
 ) -> (Vec<Vec<f64>>, Vec<Column>) {
     let mut cols = columns(axis, u);
     // the per-component columns of a multifrequency drive, last in either layout
-    let count = c
-        .first
-        .first()
-        .map_or(0, |p| p.observables.components.len());
+    let count = c.components();
     for (name, kind, what) in component_columns(count) {
         cols.push(Column::new(name, u.unit(kind), what));
     }
@@ -147,11 +144,7 @@ fn row(point: &TablePoint, u: &CurveUnits) -> Vec<f64> {
 fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params) -> Vec<Vec<f64>> {
     let omega = |v: f64| base.with(c.param, v).omega;
     let mut out = Vec::new();
-    let count = c
-        .first
-        .first()
-        .map_or(1, |p| p.observables.components.len());
-    let noise = |s: Option<&LockInNoise>| noise_row(s, count, u).into_iter().map(|v| v.1);
+    let noise = |s: Option<&LockInNoise>| noise_row(s, c.components(), u).into_iter().map(|v| v.1);
     for (k, (code, sweep)) in [(0.0, &c.first), (1.0, &c.second)].into_iter().enumerate() {
         for (i, p) in sweep.iter().enumerate() {
             let point = TablePoint {

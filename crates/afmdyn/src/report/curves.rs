@@ -502,8 +502,8 @@ pub(crate) fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Val
 /// The `"thermal"` block of `afmdyn approach --temperature T --json`
 /// ([`crate::analysis::lock_in_noise`]; the sweeps' [`NOISE_COLUMNS`] carry σ_A and σ_φ):
 /// `temperature` (K), `time_constant` (the lock-in's τ_L, in `u`'s time), `bandwidth` (its
-/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, T = 1/f_d the (first) drive's period; Hz with a probe, else per
-/// unit τ) and `method`.
+/// noise-equivalent bandwidth (f_d/2) β/(2 − β), β = 1 − e^{−T/τ_L}, T = 1/f_d the (first)
+/// drive's period; Hz with a probe, else per unit τ) and `method`.
 pub(crate) fn thermal_noise(
     params: &Params,
     temperature: f64,
@@ -519,9 +519,9 @@ pub(crate) fn thermal_noise(
         "bandwidth": 0.5 / (period * u.time) * beta / (2.0 - beta),
         "method": "the lock-in's amplitude and phase noise by linear response about each \
                    orbit: the variational flow with its saltations, the fluctuation–dissipation \
-                   theorem's white force and the lock-in's filter (one per drive component, \
-                   over the common period) as one linear chain per period, its stationary \
-                   covariance (crate::analysis::lock_in_noise)",
+                   theorem's white force and the lock-ins' filters (one per drive component, \
+                   each low-passed once per drive period) as one linear chain over the drive's \
+                   (common) period, its stationary covariance (crate::analysis::lock_in_noise)",
         "columns": noise_row(None, params.demodulated().len(), u)
             .into_iter()
             .map(|c| c.0)

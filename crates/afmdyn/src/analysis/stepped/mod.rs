@@ -400,6 +400,13 @@ impl SteppedCurve {
             .filter(|d| d.is_finite())
             .fold(0.0, f64::max)
     }
+
+    /// The number of drive components its points demodulate (0 for a single-frequency drive:
+    /// [`crate::analysis::observables::Observables::components`]).
+    pub(crate) fn components(&self) -> usize {
+        let first = self.first.first();
+        first.map_or(0, |p| p.observables.components.len())
+    }
 }
 
 /// Why a time average may not settle ([`average::slowest_beat`]): the clause for the

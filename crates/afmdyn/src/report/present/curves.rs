@@ -217,11 +217,7 @@ fn thermal(p: &mut Presentation, t: &Value, s: &Shown<'_>) {
         s.l.show(a),
         s.l.show(b)
     ));
-    let count =
-        s.c.first
-            .first()
-            .map_or(0, |p| p.observables.components.len());
-    for i in 1..count {
+    for i in 1..s.c.components() {
         let (a, b) = range(&|n| n.further[i - 1][0] * s.u.length);
         let (c, d) = range(&|n| n.further[i - 1][1].to_degrees());
         if a <= b {
