@@ -167,6 +167,7 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "schema": "image",
         "module": "image",
         "optional": ["curve_points"],
+        "omit": ["temperature"],
         "order": ["setpoint", "pixels", "lines", "curve_points"],
         "notes": {"setpoint": "With --mode peakforce the peak force the feedback holds "
                               "instead, in N or with a unit (2nN)."},
@@ -177,8 +178,12 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "schema": "image_scan",
         "module": "image_scan",
         "order": ["scan_rate", "gains", "time_constant", "temperature", "seed"],
-        "notes": {k: "Only with --feedback pi." for k in ["scan_rate", "gains", "time_constant",
-                                                           "temperature", "seed"]},
+        "notes": {**{k: "Only with --feedback pi." for k in ["scan_rate", "gains",
+                                                              "time_constant", "seed"]},
+                  "temperature": "With --feedback pi; or with --mode peakforce, every pixel's "
+                                 "σ of the peak force and the deformation from cycle to cycle "
+                                 "(maps peak_force_noise, deformation_noise: its material's "
+                                 "tap at the setpoint by linear response)."},
         "args": {"scan_rate": 'value_name = "HZ"', "gains": 'value_name = "P,I"',
                  "time_constant": 'value_name = "S"', "temperature": 'value_name = "K"'},
     },

@@ -44,6 +44,7 @@ IMAGE_INPUTS = [("probe", 'Union[str, "os.PathLike[str]", Dict[str, Any]]'),
                 ("sample", 'Union[str, "os.PathLike[str]"]')]
 #: an image's positional parameters and options (``afmdyn.image``, ``afmdyn.dask.image``)
 IMAGE = {"positional": IMAGE_INPUTS + [("setpoint", "float")], "model": False,
+         "omit": ("temperature",),  # (one of Python's own: the PI scan's or PeakForce's)
          "override": {k: ("Optional[int]", "None") for k in ("pixels", "curve_points")}}
 #: an image's keywords of Python's own (``afmdyn.dask.image`` takes no feedback nor threads)
 IMAGE_KW = [("height_map", "Optional[Any]", "None"), ("feedback", "str", '"ideal"'),
@@ -115,7 +116,7 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "image": ("image", "_image", "xr.Dataset", {**IMAGE, "own": IMAGE_KW + PROGRESS}),
         "setpoint_study": ("image", "_image", "xr.Dataset", {
             "positional": IMAGE_INPUTS + [("ratios", "Sequence[float]")], "model": False,
-            "omit": ("setpoint", "pixels", "lines"), "own": [],
+            "omit": ("setpoint", "pixels", "lines", "temperature"), "own": [],
             "override": {"curve_points": ("Optional[int]", "None")}}),
         "reconstruct": ("reconstruct", "_reconstruct", "xr.Dataset", {
             "positional": [], "model": False, "omit": ("law_force",),

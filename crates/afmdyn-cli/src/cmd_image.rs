@@ -103,7 +103,8 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         ImageMode::Am => None,
         ImageMode::Peakforce => Some(Dim::Force),
     };
-    let request = a.request.request(true, setpoint_dim)?;
+    let request =
+        (a.request.request(true, setpoint_dim)?).with_temperature(mode, a.scan.temperature);
     let pi = match options.feedback {
         ImageFeedback::Ideal => None,
         ImageFeedback::Pi => Some(a.scan.request(true)?),

@@ -36,6 +36,7 @@ impl ImageFlags {
             lines: self.lines,
             pixels: self.pixels,
             setpoint: crate::args::value_in(self.setpoint, "setpoint", mode_dim, si)?,
+            ..ImageRequest::default()
         })
     }
 }
@@ -53,7 +54,7 @@ pub struct PiScanFlags {
     #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range, section feedback); outside 1 µs–0.1 s the image warns of a likely unit slip. Not given: τ_c/4. Only with --feedback pi.")]
     pub time_constant: Option<f64>,
     /// `--temperature`: the request's `temperature`.
-    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise. With one the lines are integrated by the stochastic step (exact for the linear law, exponential Euler for Hertz, DMT and the electrostatic law; the laws with memory are refused), and the lock-in's amplitude and phase, the height and the error images carry the noise the lever's thermal motion gives them at the lock-in's bandwidth (the pixels' energy residual is then not given: the balance leaves the thermal force's work out). Only with --feedback pi.")]
+    #[arg(long, allow_negative_numbers = true, value_name = "K", help = "The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside 200–500 K it warns, a value in °C?); not given (the default): no thermal noise. With one the lines are integrated by the stochastic step (exact for the linear law, exponential Euler for Hertz, DMT and the electrostatic law; the laws with memory are refused), and the lock-in's amplitude and phase, the height and the error images carry the noise the lever's thermal motion gives them at the lock-in's bandwidth (the pixels' energy residual is then not given: the balance leaves the thermal force's work out). With --feedback pi; or with --mode peakforce, every pixel's σ of the peak force and the deformation from cycle to cycle (maps peak_force_noise, deformation_noise: its material's tap at the setpoint by linear response).")]
     pub temperature: Option<f64>,
     /// `--seed`: the request's `seed`.
     #[arg(long, default_value = "0", help = "The seed of the thermal force (with --temperature; default 0): each line draws from streams of its own, so that an image is a function of its seed whatever the threads or the executor. Only with --feedback pi.")]

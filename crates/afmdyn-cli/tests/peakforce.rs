@@ -410,3 +410,89 @@ fn a_peakforce_image_warns_of_a_biased_modulus_as_a_single_tap_does() {
     let summary = String::from_utf8_lossy(&out.stdout);
     assert!(summary.contains("dissipation 0 (round-off"), "{summary}");
 }
+
+/// `image --mode peakforce --temperature 295`: every pixel carries the σ of its material's tap
+/// at the setpoint, the single tap's of `peakforce --setpoint --temperature` on the same probe
+/// (the maps `peak_force_noise` and `deformation_noise`, each material's engaged `noise`, a
+/// `thermal` block and a summary line); a seed (the maps draw nothing) and a law with memory
+/// in a domain are refused, exit 2 naming them.
+#[test]
+fn a_peakforce_image_with_a_temperature_maps_its_materials_tap_noise() {
+    let (probe, blend) = (
+        "examples/probe-peakforce-amo-garcia.toml",
+        "examples/sample-peakforce-blend.toml",
+    );
+    let image = |extra: &[&str]| {
+        let mut args = vec![
+            "image",
+            "--mode",
+            "peakforce",
+            "--probe",
+            probe,
+            "--sample",
+            blend,
+            "--pixels",
+            "4",
+            "--lines",
+            "2",
+            "--setpoint",
+            "2nN",
+            "--temperature",
+            "295",
+        ];
+        args.extend(extra);
+        args.extend(["--files", "none"]);
+        args.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let args = image(&["--json"]);
+    let doc = common::json(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let single = common::json(&[
+        "peakforce",
+        "--probe",
+        probe,
+        "--setpoint",
+        "2nN",
+        "--temperature",
+        "295",
+        "--json",
+        "--files",
+        "none",
+    ]);
+    assert_eq!(doc["thermal"]["temperature"], 295.0);
+    let background = &doc["materials"][0];
+    for (k, map) in [
+        ("peak_force", "peak_force_noise"),
+        ("deformation", "deformation_noise"),
+    ] {
+        let sigma = background["engaged"]["noise"][k].as_f64().unwrap();
+        assert_eq!(sigma, single["thermal"][map].as_f64().unwrap(), "{k}");
+        let pixels = &background["maps"][map];
+        assert_eq!(pixels["units"], if k == "peak_force" { "N" } else { "m" });
+        assert_eq!(pixels["finite"], background["pixels"], "{map}");
+        assert_eq!(pixels["min"], pixels["max"], "{map}: one material, one tap");
+    }
+    let args = image(&[]);
+    let text = common::text(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(text.contains("background: thermal noise at 295 K, per cycle: σ(peak force) = "));
+    let args = image(&["--seed", "3"]);
+    common::refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["seed = 3: only with feedback = pi"],
+    );
+    // a JKR domain: its contact depends on its history
+    let dir = tempfile::tempdir().unwrap();
+    let jkr = dir.path().join("jkr.toml");
+    std::fs::write(
+        &jkr,
+        "size = [1.0e-6, 1.0e-6]\n[[domain]]\nname = \"soft\"\nx = [0.0, 0.5e-6]\n\
+         [domain.sample]\nlaw = \"jkr\"\nyoungs_modulus = 1e8\npoisson_ratio = 0.5\n\
+         adhesion_energy = 0.05\n",
+    )
+    .unwrap();
+    let mut args = image(&[]);
+    args[6] = jkr.to_str().unwrap().into();
+    common::refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["jkr", "temperature"],
+    );
+}

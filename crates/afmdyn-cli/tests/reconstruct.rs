@@ -195,7 +195,7 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
     for (extra, needle) in [
         (
             &["--amplitude", "1e300"][..],
-            "--amplitude = 1e300: must be ≤ 1e-5 m",
+            "--amplitude = 1e300 m: must be ≤ 1e-5 m",
         ),
         (
             &["--amplitude", "-10nm"][..],
@@ -203,7 +203,7 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
         ),
         (
             &["--amplitude", "10"][..],
-            "--amplitude = 10: must be ≤ 1e-5 m",
+            "--amplitude = 10 m: must be ≤ 1e-5 m",
         ),
         (
             &["--resonance-frequency", "-300kHz"][..],
@@ -211,16 +211,16 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
         ),
         (
             &["--resonance-frequency", "1e12"][..],
-            "--resonance-frequency = 1000000000000: above 10 GHz",
+            "--resonance-frequency = 1000000000000 Hz: above 10 GHz",
         ),
         (
             &["--resonance-frequency", "300"][..],
-            "--resonance-frequency = 300: below 1 kHz for a cantilever; frequencies are in Hz: \
+            "--resonance-frequency = 300 Hz: below 1 kHz for a cantilever; frequencies are in Hz: \
              300 kHz is 300e3",
         ),
         (
             &["--spring-constant", "1e12"][..],
-            "--spring-constant = 1000000000000: above 1e9 N/m",
+            "--spring-constant = 1000000000000 N/m: above 1e9 N/m",
         ),
     ] {
         let (code, _, err) = run_example(FM, extra);
@@ -364,7 +364,7 @@ fn calibration_refusals_name_the_flag_briefly() {
     );
     let err = refused("40", "1e300");
     assert!(
-        err.contains("--amplitude = 1e300: must be ≤ 1e-5 m"),
+        err.contains("--amplitude = 1e300 m: must be ≤ 1e-5 m"),
         "{err}"
     );
     let err = refused("40", "-10nm");

@@ -70,3 +70,26 @@ def test_the_dask_peakforce_image_equals_the_local_one():
         client.close()
         cluster.close()
     xr.testing.assert_identical(ds, _image())
+
+
+def test_a_temperature_maps_each_materials_tap_noise(cli, tmp_path):
+    """``temperature=`` gives the maps ``peak_force_noise`` and ``deformation_noise``: the
+    command line's ``image.nc`` with ``--temperature``, the background's pixels the single
+    tap's σ (``afmdyn.peakforce(setpoint=, temperature=)``); a seed is refused (nothing is
+    drawn)."""
+    ds = _image(temperature=295.0)
+    run = cli("image", "--mode", "peakforce", "--probe", PROBE, "--sample", BLEND,
+              "--setpoint", "2nN", "--pixels", "4", "--lines", "2", "--temperature", "295",
+              "--out", tmp_path)
+    assert run.returncode == 0, run.stderr
+    nc = xr.open_dataset(tmp_path / "image.nc").load()
+    with pytest.warns(afmdyn.AfmdynWarning):
+        single = afmdyn.peakforce(probe=PROBE, setpoint=2e-9, temperature=295.0)
+    for k in ("peak_force_noise", "deformation_noise"):
+        np.testing.assert_array_equal(ds[k].values, nc[k].values, err_msg=k)
+        background = ds[k].values[ds.material.values == "background"]
+        assert background.size > 0
+        np.testing.assert_allclose(background, single.attrs[k], rtol=1e-12, err_msg=k)
+    assert "peak_force_noise" not in _image().data_vars
+    with pytest.raises(ValueError, match="seed = 3: only with feedback = pi"):
+        afmdyn.image(PROBE, BLEND, 2e-9, mode="peakforce", temperature=295.0, seed=3)

@@ -70,7 +70,7 @@ def test_a_likely_unit_slip_and_a_truncated_curve_warn():
     with pytest.warns(afmdyn.AfmdynWarning, match=r"spring_constant = 40000000 N/m .* mN/m"):
         ds = afmdyn.reconstruct(**c, **{**CONSTANTS, "spring_constant": 4e7})
     assert "mN/m" in json.loads(ds.attrs["summary"])["warnings"][0]
-    with pytest.raises(ValueError, match="resonance_frequency = 300: below 1 kHz"):
+    with pytest.raises(ValueError, match="resonance_frequency = 300 Hz: below 1 kHz"):
         afmdyn.reconstruct(**c, **{**CONSTANTS, "resonance_frequency": 300.0})
     near = c["distance"] <= 2e-9
     with pytest.warns(afmdyn.AfmdynWarning, match="frequency shift at the largest distance"):

@@ -148,6 +148,8 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("image", IMAGE),
     ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
+    # the noise maps, each material's engaged noise and the thermal block
+    ("image", [*PF_IMAGE, "--temperature", 295]),
     ("image", PF_IMAGE),
     ("peakforce", ["--probe", PF]),
     # the thermal block, and the noise channels of a sweep

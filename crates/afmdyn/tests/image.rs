@@ -232,6 +232,7 @@ fn sample_maps_and_their_refusals() {
         pixels: 8,
         lines: Some(lines),
         curve_points: 40,
+        temperature: None,
     };
     for (r, key) in [
         (req(1.0, 1), "setpoint"),

@@ -53,8 +53,8 @@ fn image(pixels: usize, lines: usize, threads: usize) -> PeakForceImage {
 }
 
 /// The standalone `peakforce --setpoint` tap of the probe with `sample` as its `[sample]`
-/// (`None`: the probe's own): its document.
-fn standalone(sample: Option<&toml::Table>) -> serde_json::Value {
+/// (`None`: the probe's own) at `temperature` (K; `None`: none): its document.
+fn standalone(sample: Option<&toml::Table>, temperature: Option<f64>) -> serde_json::Value {
     let mut table = probe();
     if let Some(s) = sample {
         table.insert("sample".into(), toml::Value::Table(s.clone()));
@@ -66,6 +66,7 @@ fn standalone(sample: Option<&toml::Table>) -> serde_json::Value {
     };
     let request = PeakForceRequest {
         setpoint: Some(SETPOINT),
+        temperature,
         ..PeakForceRequest::default()
     };
     afmdyn::request::run::run(&request, &model, &Progress::new())
@@ -148,7 +149,7 @@ fn a_pixel_is_the_standalone_setpoint_tap_of_its_material() {
     let doc = map();
     let stiff = doc.domains[0].sample.as_ref().unwrap();
     for (m, sample) in [(0usize, None), (1, Some(stiff))] {
-        let d = standalone(sample);
+        let d = standalone(sample, None);
         let ch = &d["channels"];
         let e = img.materials[m].engaged.unwrap();
         // the engage is the standalone search itself: equal bit for bit
@@ -243,26 +244,34 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
 fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
     use afmdyn::study::plan::{plan, rebuild, Recipe};
     use std::sync::atomic::AtomicBool;
-    let recipe = Recipe::PeakForceImage {
-        probe: probe(),
-        map: map(),
-        request: request(6, 4),
-    };
-    let p = plan(recipe).unwrap();
-    // as Dask does: every task in a plan rebuilt from its recipe's text
-    let worker = rebuild(p.recipe()).unwrap();
-    let cancel = AtomicBool::new(false);
-    let mut results = Vec::new();
-    for stage in 0..p.stages() {
-        let st = p.stage(stage, &results).unwrap();
-        for t in st.tasks.into_iter().rev() {
-            results.push(worker.run(&st.start, t, &cancel).unwrap());
+    // with a temperature too: the engages' noise travels with them to the lines
+    for temperature in [None, Some(295.0)] {
+        let request = ImageRequest {
+            temperature,
+            ..request(6, 4)
+        };
+        let recipe = Recipe::PeakForceImage {
+            probe: probe(),
+            map: map(),
+            request,
+        };
+        let p = plan(recipe).unwrap();
+        // as Dask does: every task in a plan rebuilt from its recipe's text
+        let worker = rebuild(p.recipe()).unwrap();
+        let cancel = AtomicBool::new(false);
+        let mut results = Vec::new();
+        for stage in 0..p.stages() {
+            let st = p.stage(stage, &results).unwrap();
+            for t in st.tasks.into_iter().rev() {
+                results.push(worker.run(&st.start, t, &cancel).unwrap());
+            }
         }
+        let out = p.outcome(&results).unwrap();
+        let img = peakforce_image(&probe(), &map(), &request, Some(2), &Progress::new());
+        let direct = ImageOutput::PeakForce(img.unwrap()).outcome(SETPOINT);
+        assert_eq!(out.document, direct.document, "{temperature:?}");
+        assert_eq!(out.document.get("thermal").is_some(), temperature.is_some());
     }
-    let out = p.outcome(&results).unwrap();
-    let img = image(6, 4, 2);
-    let direct = afmdyn::study::image::ImageOutput::PeakForce(img).outcome(SETPOINT);
-    assert_eq!(out.document, direct.document);
 }
 
 /// Stripes one pixel wide at 8 pixels a line: the material changes at every pixel.
@@ -318,4 +327,59 @@ fn a_change_of_material_at_every_pixel_costs_one_tap_and_holds_the_setpoint() {
             assert!(close(t.modulus_dmt, e.modulus_dmt, 1e-6));
         }
     }
+}
+
+/// The standalone tap's σ of the peak force (N) and the deformation (m) at 295 K
+/// ([`standalone`]).
+fn standalone_noise(sample: Option<&toml::Table>) -> (f64, f64) {
+    let doc = standalone(sample, Some(295.0));
+    let sigma = |k: &str| doc["thermal"][k].as_f64().unwrap();
+    (sigma("peak_force_noise"), sigma("deformation_noise"))
+}
+
+/// With a temperature every pixel carries its material's tap noise at the setpoint: the
+/// standalone `peakforce --temperature` tap's σ (its own setpoint search and noise), where the
+/// line engages on the material and where the feedback continues into it from another (the
+/// stripes: a change at every pixel), in the maps `peak_force_noise` and `deformation_noise`
+/// and a `thermal` block; without one the maps are not there.
+#[test]
+fn a_temperature_gives_every_pixel_its_materials_tap_noise() {
+    let req = ImageRequest {
+        temperature: Some(295.0),
+        ..request(8, 1)
+    };
+    let img = peakforce_image(&probe(), &stripes(), &req, Some(2), &Progress::new()).unwrap();
+    let stripe = stripes().domains[0].sample.clone();
+    let expected = [standalone_noise(None), standalone_noise(stripe.as_ref())];
+    assert!(expected[0].0 > 0.0 && expected[1].1 > 0.0, "{expected:?}");
+    for i in 0..8 {
+        let (m, t) = (img.material[0][i], img.tap(0, i).unwrap());
+        let n = t.noise.unwrap();
+        let (f, d) = expected[usize::from(m != 0)];
+        assert!(
+            close(n.peak_force, f, 1e-6),
+            "pixel {i}: {} {f}",
+            n.peak_force
+        );
+        assert!(
+            close(n.deformation, d, 1e-6),
+            "pixel {i}: {} {d}",
+            n.deformation
+        );
+        assert_eq!(img.value("peak_force_noise", 0, i), n.peak_force);
+        assert_eq!(img.value("deformation_noise", 0, i), n.deformation);
+        // every stripe after the first pixel is continued into, not engaged
+        assert_eq!(img.pixels[0][i].evaluations, usize::from(i > 0), "{i}");
+    }
+    let doc = img.document();
+    assert_eq!(doc["thermal"]["temperature"], 295.0);
+    assert_eq!(
+        doc["image"]["peak_force_noise"][0]
+            .as_array()
+            .unwrap()
+            .len(),
+        8
+    );
+    let plain = image(2, 1, 1).document();
+    assert!(plain.get("thermal").is_none() && plain["image"].get("peak_force_noise").is_none());
 }

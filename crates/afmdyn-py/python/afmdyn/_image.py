@@ -43,7 +43,9 @@ def _keywords(a: Args, feedback: str) -> Tuple[str, Args]:
     request = dict(sample=os.fspath(sample) if isinstance(sample, os.PathLike) else sample,
                    setpoint=a["setpoint"], pixels=a["pixels"], lines=a["lines"],
                    curve_points=a["curve_points"], height_map=rows,
-                   feedback=pi if feedback == "pi" else None, threads=a.get("threads"),
+                   # (a PeakForce image's temperature is its PI settings', ImageKeywords)
+                   feedback=pi if feedback == "pi" or mode == "peakforce" else None,
+                   threads=a.get("threads"),
                    mode=None if mode == "am" else mode,
                    options=dict(options=options, given=given))
     return _core.probe_source(a["probe"]), request

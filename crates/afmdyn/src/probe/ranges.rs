@@ -296,6 +296,36 @@ pub fn refusal(section: &str, key: &str, x: f64) -> Option<String> {
     si_range(section, key)?.refusal(x)
 }
 
+/// [`refusal`] as the error of an option `name` given `x` (in the range's unit).
+///
+/// # Errors
+/// [`crate::SimError::OutOfRange`] naming `name`, where `x` is outside the physical range.
+pub(crate) fn refuse(
+    name: &'static str,
+    (section, key): (&str, &str),
+    x: f64,
+) -> Result<(), crate::SimError> {
+    let Some(r) = si_range(section, key) else {
+        return Ok(());
+    };
+    let value = || format!("{} {}", crate::error::number(x), r.unit);
+    r.refusal(x).map_or(Ok(()), |why| {
+        Err(crate::SimError::out_of_range(name, value(), why))
+    })
+}
+
+/// The warning of an option `name` given `x` outside the typical range of `[section].key`
+/// (`name = x unit is outside the typical …`, [`SiRange::warning`]), if any.
+pub(crate) fn warn(name: &str, (section, key): (&str, &str), x: f64) -> Option<String> {
+    let r = si_range(section, key)?;
+    let why = r.warning(x)?;
+    Some(format!(
+        "{name} = {} {} is {why}",
+        crate::error::number(x),
+        r.unit
+    ))
+}
+
 /// The typical-range warning of `[section].key = x` ([`SiRange::warning`]), if any.
 pub(crate) fn warning(section: &str, key: &str, x: f64) -> Option<String> {
     si_range(section, key)?.warning(x)

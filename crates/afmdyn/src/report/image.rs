@@ -433,6 +433,10 @@ pub struct PeakForceTap {
     pub period: usize,
     /// Whether the orbit is stable (every Floquet multiplier inside the unit circle).
     pub stable: bool,
+    /// With a temperature, the noise of its material's tap at the setpoint from cycle to cycle
+    /// (σ in N and m; [`crate::analysis::peakforce::tap_noise`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<crate::analysis::peakforce::TapNoise>,
 }
 
 /// One pixel of a line as its task computes it.
@@ -471,6 +475,8 @@ pub struct PeakForceImage {
     pub y: Vec<f64>,
     /// The setpoint: the peak force the feedback holds (N).
     pub setpoint: f64,
+    /// The temperature of the noise maps (K; `None`: no noise).
+    pub temperature: Option<f64>,
     /// The materials: 0 the background, then one per domain with its own sample.
     pub materials: Vec<PfMaterialReport>,
     /// The pixels' material (index into `materials`), `[line][pixel]`.
@@ -492,8 +498,9 @@ pub struct PeakForceImage {
 
 /// The numeric maps of a PeakForce image over (y, x), in SI (NaN, `null` in the document,
 /// where the setpoint is not reached): its document's `image` block and the variables of
-/// `image.nc`, in this order.
-pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
+/// `image.nc`, in this order; the last two, the noise maps, with a temperature only
+/// ([`PeakForceImage::fields`]).
+pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 11] = columns! {
     "height", Length, false, "apparent height h + z_c − z_c,ref (ideal peak-force feedback)",
         Opt(|g, &(j, i)| Some(g.true_height[j][i] + g.tap(j, i)?.z_c - g.reference));
     "true_height", Length, false, "true height of the sample map",
@@ -512,9 +519,18 @@ pub(crate) const PF_FIELDS: [Column<PeakForceImage, Cell>; 9] = columns! {
         Opt(|g, &(j, i)| Some(g.tap(j, i)?.dissipation));
     "taps_per_cycle", Fixed("1"), false, "contacts per modulation period",
         Opt(|g, &(j, i)| Some(g.tap(j, i)?.taps_per_cycle));
+    "peak_force_noise", Force, false, "peak force's thermal noise per cycle (σ)",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.noise?.peak_force));
+    "deformation_noise", Length, false, "deformation's thermal noise per cycle (σ)",
+        Opt(|g, &(j, i)| Some(g.tap(j, i)?.noise?.deformation));
 };
 
 impl PeakForceImage {
+    /// The image's maps: [`PF_FIELDS`], the noise maps with a temperature only.
+    pub(crate) fn fields(&self) -> &'static [Column<PeakForceImage, Cell>] {
+        &PF_FIELDS[..if self.temperature.is_some() { 11 } else { 9 }]
+    }
+
     /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
     pub(crate) fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
         self.pixels[line][pixel].tap.as_ref()
@@ -523,7 +539,7 @@ impl PeakForceImage {
     /// The value of the map `name` (`PF_FIELDS`) at (line, pixel) (NaN where not reached or
     /// an unknown name).
     pub fn value(&self, name: &str, line: usize, pixel: usize) -> f64 {
-        let field = PF_FIELDS.iter().find(|c| c.name == name);
+        let field = self.fields().iter().find(|c| c.name == name);
         field.map_or(f64::NAN, |c| c.number(self, &(line, pixel)))
     }
 
@@ -535,7 +551,7 @@ impl PeakForceImage {
     pub fn document(&self) -> Value {
         use serde_json::json;
         let shape = (self.y.len(), self.x.len());
-        let mut image = columns::grids(&PF_FIELDS, self, &columns::cells(shape), shape);
+        let mut image = columns::grids(self.fields(), self, &columns::cells(shape), shape);
         image.insert("x".into(), json!(self.x));
         image.insert("y".into(), json!(self.y));
         image.insert(
@@ -561,10 +577,11 @@ impl PeakForceImage {
 
     /// The document's keys other than `image` ([`PeakForceImage::document`]): `mode`,
     /// `feedback`, `setpoint` (N), `reference_z_c` (m), `materials` (name, true modulus, the
-    /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
+    /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`,
+    /// `thermal` (with a temperature: it and the noise maps' method).
     pub(crate) fn document_head(&self) -> Value {
         use serde_json::json;
-        json!({
+        let mut doc = json!({
             "mode": "peakforce",
             "feedback": "ideal",
             "setpoint": self.setpoint,
@@ -578,7 +595,14 @@ impl PeakForceImage {
             })).collect::<Vec<_>>(),
             "taps": self.taps(),
             "warnings": self.warnings,
-        })
+        });
+        if let Some(t) = self.temperature {
+            doc["thermal"] = json!({
+                "temperature": t,
+                "method": "each pixel's σ of the peak force and the deformation from cycle to cycle: its material's steady tap at the setpoint under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the tap, the pixels of a material sharing its operating point (crate::analysis::peakforce::tap_noise)",
+            });
+        }
+        doc
     }
 
     /// Steady taps computed for the image: the materials' engages and the lines' continuations.

@@ -5,7 +5,7 @@
 //! ([`crate::report::image::PiImage`], [`scan_layout`]).
 
 use super::image::SCAN_FIELDS;
-use super::image::{scan_cells, Image, PeakForceImage, PiImage, Regime, FIELDS, PF_FIELDS};
+use super::image::{scan_cells, Image, PeakForceImage, PiImage, Regime, FIELDS};
 use crate::layout::columns::{self, UnitNames};
 use crate::layout::{Attr, Layout, Values, Variable};
 
@@ -244,7 +244,7 @@ fn direction_variables(img: &PiImage, d: usize, suffix: &str) -> Vec<Variable> {
 }
 
 /// A PeakForce image's layout (`image.nc` of `afmdyn image --mode peakforce`): coordinates
-/// `x`, `y` (m); over (y, x) the [`PF_FIELDS`] as 64-bit floats in SI (NaN where the setpoint
+/// `x`, `y` (m); over (y, x) the maps ([`PeakForceImage::fields`]) as 64-bit floats in SI (NaN where the setpoint
 /// is not reached), `evaluations` (steady taps computed per pixel), `material` and `domain`
 /// (32-bit codes with their CF `flag_values` and `flag_meanings`, as in [`layout`]); the scalars
 /// `setpoint` (N) and `reference_z_c` (m).
@@ -257,7 +257,7 @@ pub(crate) fn peakforce_layout(img: &PeakForceImage) -> Layout {
         Variable::f64("y", &["y"], "m", "line position y", &img.y),
     ];
     let fields = &columns::cells((ny, nx));
-    variables.extend(columns::variables(&PF_FIELDS, img, fields, grid, &SI));
+    variables.extend(columns::variables(img.fields(), img, fields, grid, &SI));
     let evaluations: Vec<i32> = cells()
         .map(|(j, i)| img.pixels[j][i].evaluations as i32)
         .collect();

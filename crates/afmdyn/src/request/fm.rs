@@ -151,13 +151,7 @@ impl FmRequest {
             if length != 1.0 {
                 // an amplitude's range is the probe's amplitude's ([`crate::probe::ranges`]),
                 // not a rest distance's
-                if let Some(why) = crate::probe::ranges::refusal("drive", "free_amplitude", a) {
-                    return Err(SimError::out_of_range(
-                        "amplitude",
-                        format!("{} m", crate::error::number(a)),
-                        why,
-                    ));
-                }
+                crate::probe::ranges::refuse("amplitude", ("drive", "free_amplitude"), a)?;
             }
             // the model's lengths are in units of its A₀ (g₀): an amplitude 1e8 times smaller
             // or 1e4 times larger leaves nothing of the other length scales

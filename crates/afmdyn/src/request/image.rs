@@ -85,6 +85,14 @@ pub struct ImageRequest {
     /// default 120, the approach's default: [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
     #[serde(default = "default_curve_points")]
     pub curve_points: usize,
+    /// A PeakForce image's temperature T (K, > 0 and ≤ 1500; outside 200–500 K it warns): every
+    /// pixel's σ of the peak force and the deformation from cycle to cycle, its material's tap
+    /// at the setpoint under the lever's thermal force
+    /// ([`crate::analysis::peakforce::tap_noise`]); `None`: no noise. Front ends take the one
+    /// `temperature` of an image ([`ImageRequest::with_temperature`]); an AM image's is its PI
+    /// scan's ([`super::image_scan::PiScan`]) and refused here.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<f64>,
 }
 
 /// [`ImageRequest::pixels`]' default: 64.
@@ -113,7 +121,16 @@ impl ImageRequest {
             pixels: default_pixels(),
             lines: None,
             curve_points: default_curve_points(),
+            temperature: None,
         }
+    }
+
+    /// The request with the image's `temperature` as a front end takes it: a PeakForce
+    /// image's ([`ImageRequest::temperature`]); an AM image's is its PI scan's, not the
+    /// request's.
+    pub fn with_temperature(mut self, mode: super::image_job::ImageMode, t: Option<f64>) -> Self {
+        self.temperature = t.filter(|_| mode == super::image_job::ImageMode::Peakforce);
+        self
     }
 
     /// The request at `setpoint` with the options a front end was given (`None`: the
@@ -148,12 +165,16 @@ impl ImageRequest {
     /// Check the request against the map.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `setpoint` (in (0, 1)), `pixels`, `lines` (1..=4096;
-    /// 1 for a line map) or `curve_points` (8..=2000).
+    /// [`SimError::OutOfRange`] naming `setpoint` (in (0, 1)), `temperature` (a PeakForce
+    /// image's), `pixels`, `lines` (1..=4096; 1 for a line map) or `curve_points` (8..=2000).
     pub fn validate(&self, map: &SampleMap) -> Result<(), SimError> {
         let why = "must be a ratio A_sp/A0 in (0, 1)";
         let open = (Excluded(0.0), Excluded(1.0));
         crate::error::within("setpoint", self.setpoint, open, why)?;
+        if let Some(t) = self.temperature {
+            let why = "an AM image's thermal noise is its PI scan's (feedback = pi)";
+            return Err(SimError::out_of_range("temperature", t, why));
+        }
         self.validate_grid(map)
     }
 

@@ -48,7 +48,8 @@ impl ImageJob {
     }
 
     /// [`Request::validate`] of a PeakForce image: the grid, an off-resonance probe, a
-    /// setpoint force > 0, no PI feedback and no setpoint study.
+    /// setpoint force > 0, no PI feedback and no setpoint study (a temperature and the
+    /// materials' laws are checked with its cost, which reads them).
     fn validate_peakforce(&self) -> Result<(), SimError> {
         if self.feedback.is_some() || self.study.is_some() {
             return Err(SimError::out_of_range(
@@ -83,7 +84,8 @@ pub struct ImageKeywords {
     pub curve_points: Option<usize>,
     /// Heights (m), `[row][column]`, replacing the map's height map.
     pub height_map: Option<Vec<Vec<f64>>>,
-    /// `None`: the ideal feedback; else a PI scan with these settings.
+    /// `None`: the ideal feedback; else a PI scan with these settings (with
+    /// [`ImageMode::Peakforce`], whose feedback is ideal, only their temperature).
     pub feedback: Option<PiScan>,
     /// A PI scan's worker threads (`None`: all cores).
     pub threads: Option<usize>,
@@ -119,9 +121,11 @@ impl ImageKeywords {
     }
 
     /// The image request of the keywords (its setpoint as given: A_sp/A₀, or N with
-    /// [`ImageMode::Peakforce`]).
+    /// [`ImageMode::Peakforce`], whose temperature is [`ImageKeywords::feedback`]'s).
     pub fn request(&self) -> ImageRequest {
+        let t = self.feedback.and_then(|f| f.temperature);
         ImageRequest::with(self.setpoint, self.pixels, self.lines, self.curve_points)
+            .with_temperature(self.mode.unwrap_or_default(), t)
     }
 
     /// The job of the probe file's text `probe` (the ideal image, or the PI scan).
@@ -132,12 +136,13 @@ impl ImageKeywords {
     pub fn job(self, probe: &str) -> Result<ImageJob, SimError> {
         self.check()?;
         let (probe, sample) = self.inputs(probe)?;
+        let mode = self.mode.unwrap_or_default();
         Ok(ImageJob {
-            mode: self.mode.unwrap_or_default(),
+            mode,
             probe,
             sample,
             request: self.request(),
-            feedback: self.feedback,
+            feedback: self.feedback.filter(|_| mode == ImageMode::Am),
             study: None,
             threads: self.threads,
         })
@@ -163,11 +168,11 @@ impl ImageKeywords {
 impl_request! {
     ImageJob, "image";
     validate |r, _| {
-        r.request.validate(&r.sample)?;
         check_threads(r.threads)?;
         if r.mode == ImageMode::Peakforce {
             return r.validate_peakforce();
         }
+        r.request.validate(&r.sample)?;
         let background = background_probe(&r.probe)?;
         background.serves("image --mode am", crate::probe::ProbeNeeds::Tapping)?;
         match (&r.feedback, &r.study) {

@@ -86,8 +86,11 @@ impl ImageOptions {
         match self.feedback {
             ImageFeedback::Ideal => {
                 let only = "only with feedback = pi (the ideal feedback has no loop)";
-                // every setting given but the curves' is the PI scan's
-                for name in GIVEN.into_iter().filter(|n| *n != "curve_points") {
+                // every setting given but the curves' is the PI scan's (and with PeakForce the
+                // temperature: its noise maps)
+                let pf = self.mode == ImageMode::Peakforce;
+                let own = ["curve_points", if pf { "temperature" } else { "" }];
+                for name in GIVEN.into_iter().filter(|n| !own.contains(n)) {
                     if let Some(v) = value(name) {
                         return Err(SimError::out_of_range(name, v.clone(), only));
                     }

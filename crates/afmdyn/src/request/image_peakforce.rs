@@ -7,7 +7,7 @@
 
 use super::costs::{newton_work, steady_periods, MODEL_BYTES};
 use super::image::{background_probe, material_models, pixel_grid, ImageRequest, SampleMap};
-use super::limits::Cost;
+use super::limits::{thermal_force, Cost};
 use crate::analysis::peakforce::{PeakForceOptions, BRACKET_STEPS, SETPOINT_ITERATIONS};
 use crate::error::SimError;
 use crate::probe::Probe;
@@ -21,18 +21,12 @@ pub(crate) const TAPS_PER_CHANGE: f64 = 1.0;
 ///
 /// # Errors
 /// As the background probe of an AM image (a probe the format refuses, a multifrequency
-/// drive); [`SimError::OutOfRange`] naming `excitation` for a probe without
-/// an off-resonance drive, `setpoint` for a setpoint that is not a finite force > 0.
+/// drive); [`SimError::OutOfRange`] naming `excitation` or `omega` for a probe without an
+/// off-resonance drive ([`super::peakforce::check_off_resonance`]), `setpoint` for a setpoint
+/// that is not a finite force > 0.
 pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe, SimError> {
     let background = background_probe(probe_table)?;
-    if !background.off_resonance {
-        return Err(SimError::out_of_range(
-            "excitation",
-            background.params.excitation.name(),
-            "a PeakForce image needs a probe with [drive] mode = \"off-resonance\" \
-             (modulation_frequency, modulation_amplitude)",
-        ));
-    }
+    super::peakforce::check_off_resonance(&background.params, background.off_resonance)?;
     super::limits::positive(
         "setpoint",
         setpoint,
@@ -43,11 +37,13 @@ pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Resul
 }
 
 /// What a PeakForce image of `map` costs: the materials' engages (the feedback's bracket and
-/// iterations each), [`TAPS_PER_CHANGE`] taps at every change of material along the lines, and
-/// the pixels' memory.
+/// iterations each), [`TAPS_PER_CHANGE`] taps at every change of material along the lines,
+/// each material's thermal noise with a temperature, and the pixels' memory.
 ///
 /// # Errors
-/// As [`peakforce_probe`], the probe's models and the taps' transient estimate.
+/// As [`peakforce_probe`], the probe's models and the taps' transient estimate; as
+/// [`thermal_force`] for the temperature; [`SimError::Unsupported`] for a material's law with
+/// memory under one.
 pub(crate) fn peakforce_cost(
     probe_table: &toml::Table,
     map: &SampleMap,
@@ -72,8 +68,17 @@ pub(crate) fn peakforce_cost(
         })
         .sum();
     let engages = models.len() as f64 * (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64;
+    // with a temperature, each material's noise at its engage, its law admitted
+    let mut noise = 0.0;
+    if let Some(t) = req.temperature {
+        thermal_force(t, 0, Some(&background))?;
+        for (_, q) in &models {
+            crate::integrate::exact::noise::admits(&q.contact_law)?;
+            noise += super::peakforce::noise_work(q);
+        }
+    }
     Ok(Cost {
         bytes: MODEL_BYTES + req.pixel_bytes(map),
-        work: (engages + changes as f64 * TAPS_PER_CHANGE) * tap,
+        work: (engages + changes as f64 * TAPS_PER_CHANGE) * tap + noise,
     })
 }

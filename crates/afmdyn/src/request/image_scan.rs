@@ -19,7 +19,7 @@
 use super::image::{ImageRequest, SampleMap};
 use super::limits::positive;
 use crate::analysis::am_loop::{FeedbackGains, LOCK_IN_SAMPLES};
-use crate::error::{number, within, SimError};
+use crate::error::{within, SimError};
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 
@@ -121,9 +121,7 @@ pub(crate) fn lock_in_time_constant(probe: &Probe, given: Option<f64>) -> Result
         0.0..f64::INFINITY,
         "must be a finite time ≥ 0 (s)",
     )?;
-    if let Some(why) = crate::probe::ranges::refusal("feedback", "time_constant", v) {
-        return Err(SimError::out_of_range("time_constant", number(v), why));
-    }
+    crate::probe::ranges::refuse("time_constant", ("feedback", "time_constant"), v)?;
     Ok(v)
 }
 

@@ -30,8 +30,14 @@
 /// `impl Request for TYPE` of a request whose methods are one expression each: its name, its
 /// `COST_ADVICE` and `probe_needs` where they are not the trait's defaults, and the bodies of
 /// `validate`, `cost` and (where it is not the model's parameters) `computed_at`, each over
-/// the request and its model (`|r, model|`).
+/// the request and its model (`|r, model|`); `[TYPE, NAME; …]` first, several requests sharing
+/// the bodies.
 macro_rules! impl_request {
+    ([] $($rest:tt)*) => {};
+    ([$t:ty, $name:literal $(; $ts:ty, $names:literal)*] $($rest:tt)*) => {
+        impl_request! { $t, $name; $($rest)* }
+        impl_request! { [$($ts, $names);*] $($rest)* }
+    };
     (
         $(#[$attr:meta])*
         $t:ty, $name:literal $(, advice = $advice:expr)? $(, needs = $needs:ident)?;

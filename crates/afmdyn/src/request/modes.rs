@@ -20,13 +20,6 @@ const NO_WORK: Cost = Cost {
 #[serde(deny_unknown_fields)]
 pub struct ModesRequest {}
 
-// two eigenproblems of 2N × 2N: no integration
-impl_request! {
-    ModesRequest, "modes";
-    validate |_, model| Ok(model.params.validate_fields()?);
-    cost |_, _| Ok(NO_WORK)
-}
-
 /// `modes --sweep fig3`: the paper's Fig. 3 maps, ω₁/ω₀₁ and ω₂/ω₀₂ of the contact system
 /// over the α1 × α4 grid (`crate::report::present::modes::fig3_alpha1` ×
 /// `crate::report::present::modes::fig3_alpha4`) at the model's N (`crate::eigen::fig3_sweep`).
@@ -37,9 +30,9 @@ pub struct Fig3Request {
     pub out: String,
 }
 
-// 11 × 101 eigenproblems of 2N × 2N: no integration
+// two eigenproblems of 2N × 2N, and the figure's 11 × 101: no integration
 impl_request! {
-    Fig3Request, "modes";
+    [ModesRequest, "modes"; Fig3Request, "modes"]
     validate |_, model| Ok(model.params.validate_fields()?);
     cost |_, _| Ok(NO_WORK)
 }
@@ -57,19 +50,13 @@ pub struct UnitsRequest {
     pub physical: Option<PhysicalModel>,
 }
 
-impl_request! {
-    UnitsRequest, "units";
-    validate |_, _| Ok(());
-    cost |_, _| Ok(NO_WORK)
-}
-
 /// `cantilevers`: the lever library (nominal k, f₀, Q and tip radius, with their sources;
 /// [`crate::cantilevers`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CantileversRequest {}
 
 impl_request! {
-    CantileversRequest, "cantilevers";
+    [UnitsRequest, "units"; CantileversRequest, "cantilevers"]
     validate |_, _| Ok(());
     cost |_, _| Ok(NO_WORK)
 }

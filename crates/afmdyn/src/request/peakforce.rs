@@ -120,23 +120,7 @@ impl PeakForceRequest {
             Some(pr) => pr.off_resonance,
             None => !p.is_force_driven() && !p.is_multifrequency(),
         };
-        if !off_resonance {
-            return Err(SimError::out_of_range(
-                "excitation",
-                p.excitation.name(),
-                "peakforce needs a modulated sample or base: a probe with [drive] mode = \
-                 \"off-resonance\" (modulation_frequency, modulation_amplitude), or a model \
-                 with excitation = \"sample\" (or the beam's base drive) and one drive frequency",
-            ));
-        }
-        if p.omega / first_natural_frequency(&p) > MAX_MODULATION_RATIO {
-            return Err(SimError::out_of_range(
-                "omega",
-                p.omega,
-                "the modulation must lie below half the lever's first resonance (f_m/f₀ ≤ \
-                 0.5) to be off resonance",
-            ));
-        }
+        check_off_resonance(&p, off_resonance)?;
         self.options().validate()?;
         if let Some(fc) = self.filter_cutoff {
             // the cycle's sampling interval in the document's time unit (s with a probe), its
@@ -315,6 +299,40 @@ impl PeakForceRequest {
     }
 }
 
+/// That `p`, whose drive is an off-resonance modulation where `off_resonance` (its probe's
+/// drive mode, or a model's sample or base excitation at one frequency), is modulated below
+/// half the lever's first resonance: a single tap's and a PeakForce image's check.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `excitation` or `omega`.
+pub(crate) fn check_off_resonance(p: &Params, off_resonance: bool) -> Result<(), SimError> {
+    if !off_resonance {
+        return Err(SimError::out_of_range(
+            "excitation",
+            p.excitation.name(),
+            "peakforce needs a modulated sample or base: a probe with [drive] mode = \
+             \"off-resonance\" (modulation_frequency, modulation_amplitude), or a model \
+             with excitation = \"sample\" (or the beam's base drive) and one drive frequency",
+        ));
+    }
+    if p.omega / first_natural_frequency(p) > MAX_MODULATION_RATIO {
+        return Err(SimError::out_of_range(
+            "omega",
+            p.omega,
+            "the modulation must lie below half the lever's first resonance (f_m/f₀ ≤ \
+             0.5) to be off resonance",
+        ));
+    }
+    Ok(())
+}
+
+/// The work of a tap's thermal noise ([`crate::analysis::peakforce::tap_noise`]) on `q`: its
+/// walk over the tap, 512 parts per lever period, each like the lock-in's (NOISE_PERIODS per 512
+/// parts), more in contact (NOISE_CONTACT).
+pub(crate) fn noise_work(q: &Params) -> f64 {
+    NOISE_CONTACT * NOISE_PERIODS * q.modes as f64 * first_natural_frequency(q) / q.omega
+}
+
 impl_request! {
     PeakForceRequest, "peakforce", advice = "ask for fewer samples or sweep values";
     validate |r, model| r.params(model).map(|_| ());
@@ -341,11 +359,7 @@ impl_request! {
             1.0
         };
         let fit = crate::analysis::peakforce::FIT_SAMPLES as f64;
-        // the thermal noise's walk over each tap: 512 parts per lever period, each like the
-        // lock-in's (NOISE_PERIODS per 512 parts), more in contact (NOISE_CONTACT)
-        let lever_periods: f64 = points.iter().map(|q| first_natural_frequency(q) / q.omega).sum();
-        let noise = NOISE_CONTACT * NOISE_PERIODS * p.modes as f64 * lever_periods;
-        let noise = r.temperature.map_or(0.0, |_| noise);
+        let noise = r.temperature.map_or(0.0, |_| points.iter().map(noise_work).sum());
         // the thermally driven run: its cycles and burn-in (a tenth), `samples` points each,
         // a point SAMPLE_WORK per mode
         let per_cycle = 1.1 * r.samples as f64 * SAMPLE_WORK * p.modes as f64;

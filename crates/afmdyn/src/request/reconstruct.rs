@@ -99,16 +99,11 @@ impl FmInversion {
 /// The probe quantities of the constants `amplitude`, `resonance_frequency`,
 /// `spring_constant` (in that order): their ranges are the probe's, declared once in
 /// [`crate::probe::ranges`].
-pub(crate) const CONSTANTS: [(&str, &str, &str); 3] = [
-    ("amplitude", "drive", "free_amplitude"),
-    ("resonance_frequency", "cantilever", "resonance_frequency"),
-    ("spring_constant", "cantilever", "spring_constant"),
+pub(crate) const CONSTANTS: [(&str, (&str, &str)); 3] = [
+    ("amplitude", ("drive", "free_amplitude")),
+    ("resonance_frequency", ("cantilever", "resonance_frequency")),
+    ("spring_constant", ("cantilever", "spring_constant")),
 ];
-
-/// The ranges of a constant ([`CONSTANTS`]).
-fn range_of(section: &str, key: &str) -> &'static crate::probe::ranges::SiRange {
-    crate::probe::ranges::si_range(section, key).expect("the constants' ranges are declared")
-}
 
 /// The share of its extreme that |Δf| may keep at the largest distance without the truncation
 /// warning: the inversion integrates Δf beyond each distance and stops at the data's end.
@@ -143,11 +138,9 @@ impl ReconstructRequest {
     /// (distances not monotonic among them).
     pub fn curve(&self) -> Result<ShiftCurve, SimError> {
         // the constants first: a wrong unit would otherwise show as distances out of order
-        for ((name, section, key), v) in CONSTANTS.iter().zip(self.constants()) {
+        for ((name, range), v) in CONSTANTS.iter().zip(self.constants()) {
             super::limits::positive(name, v, "must be finite and > 0")?;
-            if let Some(why) = range_of(section, key).refusal(v) {
-                return Err(SimError::out_of_range(name, v, why));
-            }
+            crate::probe::ranges::refuse(name, *range, v)?;
         }
         let distance: Vec<f64> =
             match (&self.distance, &self.z_c) {
@@ -204,11 +197,7 @@ impl ReconstructRequest {
         let mut warnings: Vec<String> = CONSTANTS
             .iter()
             .zip(self.constants())
-            .filter_map(|((name, section, key), v)| {
-                let r = range_of(section, key);
-                let why = r.warning(v)?;
-                Some(format!("{name} = {} {} is {why}", number(v), r.unit))
-            })
+            .filter_map(|(&(name, range), v)| crate::probe::ranges::warn(name, range, v))
             .collect();
         if let Ok(c) = self.curve() {
             warnings.extend(shift_curve_slips(

@@ -250,12 +250,11 @@ fn warnings(
     let unit = if model.probe.is_some() { "m" } else { "g0" };
     if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
         // the amplitude's typical range is the probe's ([`crate::probe::ranges`])
-        if let Some(why) = crate::probe::ranges::warning("drive", "free_amplitude", a) {
-            warnings.push(format!(
-                "amplitude = {} m is {why}",
-                crate::error::number(a)
-            ));
-        }
+        warnings.extend(crate::probe::ranges::warn(
+            "amplitude",
+            ("drive", "free_amplitude"),
+            a,
+        ));
     }
     if let (Some(from), Some(to)) = (request.from, request.to) {
         if from < to {

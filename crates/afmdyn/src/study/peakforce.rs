@@ -494,59 +494,14 @@ fn thermal_block(
     let (n, t) = (r.noise?, request.temperature?);
     warnings.extend(crate::request::limits::temperature_warnings(t));
     // every tap's noise beside its channels: the single tap's, or each value's of a sweep
-    let taps: Vec<(TapNoise, &SteadyTap)> = match &r.sweep {
+    let channels = |n: TapNoise, t: &SteadyTap| (n, t.channels.peak_force, t.channels.deformation);
+    let taps: Vec<(TapNoise, f64, f64)> = match &r.sweep {
         Some(s) => (s.iter())
-            .filter_map(|v| Some((v.noise?, v.tap.as_ref()?)))
+            .filter_map(|v| Some(channels(v.noise?, v.tap.as_ref()?)))
             .collect(),
-        None => vec![(n, &r.tap)],
+        None => vec![channels(n, &r.tap)],
     };
-    // a channel whose σ passes MAX_LINEAR_NOISE of its value at some tap
-    let over = |sigma: f64, value: f64| sigma > MAX_LINEAR_NOISE * value.abs();
-    let mut large = Vec::new();
-    if taps
-        .iter()
-        .any(|(n, t)| over(n.peak_force, t.channels.peak_force))
-    {
-        large.push("peak force");
-    }
-    if taps
-        .iter()
-        .any(|(n, t)| over(n.deformation, t.channels.deformation))
-    {
-        large.push("deformation");
-    }
-    if !large.is_empty() {
-        let (what, percent) = (large.join(" and "), MAX_LINEAR_NOISE * 100.0);
-        warnings.push(warning!(
-            "thermal.noise-large",
-            "Read the thermal block as an estimate; the peaks' distribution is then skewed.",
-            "the thermal noise of the {what} is more than {percent:.0} % of the channel \
-             itself: its linear response about the steady tap is at its limit (the noise may \
-             make or break contact, which no linearisation holds)"
-        ));
-    }
-    if taps.iter().any(|(n, _)| n.flat_peak) {
-        warnings.push(warning!(
-            "thermal.flat-peak",
-            "Read peak_force_noise and deformation_noise as the channels' σ at the peak's time; \
-             a thermally driven run (thermal_cycles) measures the per-cycle maxima.",
-            "the tap's peak is flat against the thermal noise (the noise's slope shifts the \
-             per-cycle maximum by more than {MAX_PEAK_SHIFT} of its σ): each cycle's peak is \
-             then the largest of several fluctuations, narrower in spread and higher than the \
-             linear response's σ at the peak's time"
-        ));
-    }
-    if r.simulated.is_none() && taps.iter().any(|(n, _)| n.snap_in) {
-        warnings.push(warning!(
-            "thermal.snap-in",
-            "Read the σ as the typical cycle's spread; a thermally driven run of the tap \
-             (thermal_cycles, --thermal-cycles) measures the rare hard taps.",
-            "the tap jumps to contact (out of contact the attraction's stiffness passes the \
-             lever's): the noise moves the jump nonlinearly, so the linear response gives the \
-             Gaussian core of the peaks' spread, not its tail of rare hard taps (8× the variance \
-             in a simulated tap on polystyrene, crate::analysis::peakforce::tap_noise)"
-        ));
-    }
+    warnings.extend(linear_warnings(&taps, r.simulated.is_none()));
     // the thermally driven run against the linear response, beyond its standard errors and
     // MAX_LINEAR_NOISE of itself (wider only at a flat peak, whose narrower maxima are said)
     let off = |linear: f64, [sim, se]: [f64; 2]| {
@@ -595,6 +550,56 @@ fn thermal_block(
         "units": units,
         "method": "standard deviations from cycle to cycle of the force and the deformation at their peaks' times (the per-cycle maxima's where the peak is sharp: thermal.flat-peak) under the fluctuation–dissipation theorem's thermal force on the lever and its medium, by linear response about the steady tap: the deviations' chain over the orbit (flow Jacobians and saltation matrices, the noise of each part exact where the motion is linear, else by the trapezoid rule), its stationary covariance by doubling, read at each channel's extremum (crate::analysis::peakforce::tap_noise)",
     }))
+}
+
+/// The linear response's warnings over taps' noise beside their channels, `(σ, peak force,
+/// deformation)` in one system of units: a σ past [`MAX_LINEAR_NOISE`] of its channel, a peak
+/// flat against the noise and, with `snap_in`, a jump to contact (none where a thermally driven
+/// run measures it).
+pub(crate) fn linear_warnings(taps: &[(TapNoise, f64, f64)], snap_in: bool) -> Vec<String> {
+    let mut warnings = Vec::new();
+    // a channel whose σ passes MAX_LINEAR_NOISE of its value at some tap
+    let over = |sigma: f64, value: f64| sigma > MAX_LINEAR_NOISE * value.abs();
+    let mut large = Vec::new();
+    if taps.iter().any(|(n, f, _)| over(n.peak_force, *f)) {
+        large.push("peak force");
+    }
+    if taps.iter().any(|(n, _, d)| over(n.deformation, *d)) {
+        large.push("deformation");
+    }
+    if !large.is_empty() {
+        let (what, percent) = (large.join(" and "), MAX_LINEAR_NOISE * 100.0);
+        warnings.push(warning!(
+            "thermal.noise-large",
+            "Read the thermal block as an estimate; the peaks' distribution is then skewed.",
+            "the thermal noise of the {what} is more than {percent:.0} % of the channel \
+             itself: its linear response about the steady tap is at its limit (the noise may \
+             make or break contact, which no linearisation holds)"
+        ));
+    }
+    if taps.iter().any(|(n, ..)| n.flat_peak) {
+        warnings.push(warning!(
+            "thermal.flat-peak",
+            "Read peak_force_noise and deformation_noise as the channels' σ at the peak's time; \
+             a thermally driven run (thermal_cycles) measures the per-cycle maxima.",
+            "the tap's peak is flat against the thermal noise (the noise's slope shifts the \
+             per-cycle maximum by more than {MAX_PEAK_SHIFT} of its σ): each cycle's peak is \
+             then the largest of several fluctuations, narrower in spread and higher than the \
+             linear response's σ at the peak's time"
+        ));
+    }
+    if snap_in && taps.iter().any(|(n, ..)| n.snap_in) {
+        warnings.push(warning!(
+            "thermal.snap-in",
+            "Read the σ as the typical cycle's spread; a thermally driven run of the tap \
+             (thermal_cycles, --thermal-cycles) measures the rare hard taps.",
+            "the tap jumps to contact (out of contact the attraction's stiffness passes the \
+             lever's): the noise moves the jump nonlinearly, so the linear response gives the \
+             Gaussian core of the peaks' spread, not its tail of rare hard taps (8× the variance \
+             in a simulated tap on polystyrene, crate::analysis::peakforce::tap_noise)"
+        ));
+    }
+    warnings
 }
 
 /// A column of the cycle in the document's units.

@@ -40,8 +40,8 @@
 use super::peakforce::{modulus_scale, setpoint_in_newtons};
 use super::Tasks;
 use crate::analysis::peakforce::{
-    peak_force_setpoint, static_compliance, steady_tap_from, PeakForceOptions, SetpointOptions,
-    SteadyTap, SETPOINT_TOL,
+    peak_force_setpoint, static_compliance, steady_tap_from, tap_noise, PeakForceOptions,
+    SetpointOptions, SteadyTap, TapNoise, SETPOINT_TOL,
 };
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -49,6 +49,7 @@ use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
 use crate::request::image::{material_models, pixel_grid, ImageRequest, SampleMap};
 use crate::request::image_peakforce::peakforce_probe;
+use crate::request::limits::thermal_force;
 use crate::request::run::Resolved;
 use nalgebra::DVector;
 use serde_json::Value;
@@ -126,6 +127,8 @@ pub struct PeakForceImageStudy {
     pub options: PeakForceOptions,
     /// What a resumed run must match.
     pub fingerprint: Value,
+    /// k_B T of the noise maps (model units; with a temperature).
+    pub kt: Option<f64>,
 }
 
 /// A material's engage from far, as a task computes it: the steady taps of the feedback's
@@ -190,6 +193,13 @@ impl PeakForceImageStudy {
         let background = peakforce_probe(probe_table, req.setpoint)?;
         let units = CurveUnits::from_scales(&background.scales, true);
         let (models, of_domain, probe_warnings) = material_models(probe_table, map, &background)?;
+        // k_B T of the noise maps (the materials' laws are admitted with the request's cost,
+        // and by the noise's walk)
+        let kt = (req
+            .temperature
+            .map(|t| thermal_force(t, 0, Some(&background))))
+        .transpose()?
+        .map(|f| f.kt);
         let resolved = |p: Params| Resolved {
             params: p,
             probe: Some(background.clone()),
@@ -225,6 +235,7 @@ impl PeakForceImageStudy {
             units,
             options: PeakForceOptions::default(),
             fingerprint,
+            kt,
         })
     }
 
@@ -242,7 +253,8 @@ impl PeakForceImageStudy {
         };
         Ok(match peak_force_setpoint(&params, self.setpoint, &opts) {
             Ok(s) => {
-                let tap = si_tap(&params, &self.units, self.scale(m), s.alpha5, &s.tap);
+                let mut tap = si_tap(&params, &self.units, self.scale(m), s.alpha5, &s.tap);
+                tap.noise = self.noise(&params.with(SweepParam::Alpha5, s.alpha5), &s.tap)?;
                 (
                     s.evaluations,
                     Ok((s.alpha5, s.tap.state.iter().copied().collect(), tap)),
@@ -254,6 +266,26 @@ impl PeakForceImageStudy {
                 (0, Err(setpoint_in_newtons(e, newtons).to_string()))
             }
         })
+    }
+
+    /// The thermal noise of the tap `tap` of `params` in SI (`None` without a temperature):
+    /// a pixel's, every pixel of a material taking its engage's (its operating point at the
+    /// setpoint, to the feedback's tolerance).
+    ///
+    /// # Errors
+    /// As [`tap_noise`].
+    fn noise(&self, params: &Params, tap: &SteadyTap) -> Result<Option<TapNoise>, SimError> {
+        let Some(kt) = self.kt else { return Ok(None) };
+        let (model, integrator) = (
+            CantileverModel::new(params)?,
+            self.options.integrator.clone(),
+        );
+        let n = tap_noise(&model, &tap.state, tap.period, kt, integrator)?;
+        Ok(Some(TapNoise {
+            peak_force: n.peak_force * self.units.force,
+            deformation: n.deformation * self.units.length,
+            ..n
+        }))
     }
 
     /// The study with the materials' engages (in the order of the materials).
@@ -324,7 +356,8 @@ impl PeakForceImageStudy {
                 // and orbit (its operating point at the setpoint, module docs)
                 Some(_) => match self.continue_to(&mat.params, &mat.engaged)? {
                     (Some((b5, tap)), evaluations) => {
-                        let si = si_tap(&mat.params, &self.units, self.scale(m), b5, &tap);
+                        let mut si = si_tap(&mat.params, &self.units, self.scale(m), b5, &tap);
+                        si.noise = mat.engaged.as_ref().ok().and_then(|e| e.2.noise);
                         let pixel = LinePixel {
                             tap: Some(si),
                             evaluations,
@@ -438,6 +471,7 @@ fn si_tap(
         taps_per_cycle: c.taps_per_cycle,
         period: tap.period,
         stable: tap.stable,
+        noise: None,
     }
 }
 
@@ -571,6 +605,14 @@ impl PeakForceImageStudy {
             ));
         }
         warnings.extend(self.modulus_bias(&materials, &pixels, &x, &y));
+        if let Some(t) = self.request.temperature {
+            // the linear response's limits at each material's tap (every pixel's, module docs)
+            warnings.extend(crate::request::limits::temperature_warnings(t));
+            let engaged = materials.iter().filter_map(|m| m.engaged);
+            let taps: Vec<_> =
+                (engaged.filter_map(|e| Some((e.noise?, e.peak_force, e.deformation)))).collect();
+            warnings.extend(super::peakforce::linear_warnings(&taps, true));
+        }
         if taps().any(|t| !t.stable) {
             warnings.push(warning!(
                 "peakforce-image.unstable",
@@ -581,6 +623,7 @@ impl PeakForceImageStudy {
         }
         Ok(PeakForceImage {
             setpoint: self.request.setpoint,
+            temperature: self.request.temperature,
             reference: materials[0].engaged.map_or(f64::NAN, |t| t.z_c),
             material: y
                 .iter()

@@ -29,7 +29,7 @@ use crate::analysis::am_loop::{
     engage_position, scan_line, Engage, LineSpec, ScanLine, LOCK_IN_SAMPLES,
 };
 use crate::analysis::approach::rest_distance;
-use crate::error::{number, SimError};
+use crate::error::SimError;
 use crate::integrate::IntegratorOptions;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
@@ -323,10 +323,9 @@ impl ScanStudy {
         // a lock-in time constant given outside the typical range: a likely unit slip, named
         // (the lever's default τ_c/4 is no slip, whatever its value)
         if let Some(tc) = self.recipe.scan.time_constant {
-            if let Some(why) = crate::probe::ranges::warning("feedback", "time_constant", tc) {
-                img.warnings
-                    .push(format!("time_constant = {} s is {why}", number(tc)));
-            }
+            let range = ("feedback", "time_constant");
+            img.warnings
+                .extend(crate::probe::ranges::warn("time_constant", range, tc));
         }
         img.artefacts = [0, 1].map(|d| img.artefacts_of(d));
         for (d, a) in ["trace", "retrace"].iter().zip(img.artefacts) {

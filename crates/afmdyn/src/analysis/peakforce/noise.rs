@@ -48,7 +48,7 @@ use serde::Serialize;
 /// The standard deviations of a tap's channels at their peaks' times under the thermal force,
 /// from cycle to cycle (model units; NaN where the orbit has no stationary noise, an unstable
 /// tap): the per-cycle maxima's where the peaks are sharp ([`TapNoise::flat_peak`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct TapNoise {
     /// σ of the peak force, F̃ (0 where no force acts over the cycle).
     pub peak_force: f64,

@@ -6,7 +6,7 @@ use crate::error::number;
 use crate::layout::columns::UnitNames;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::image::{DomainContrast, Image, OperatingPoint, PeakForceImage, PeakForceTap};
-use crate::report::image::{PiImage, SetpointStudy, PF_FIELDS};
+use crate::report::image::{PiImage, SetpointStudy};
 use crate::report::image_layout::{layout, number_summary, peakforce_layout, scan_layout, summary};
 use crate::report::{Presentation, TextUnits};
 use serde_json::{json, Value};
@@ -394,7 +394,7 @@ pub(crate) fn peakforce_summary(img: &PeakForceImage) -> Value {
             .collect();
         let pixels = || mine.iter().map(|&(j, i)| &img.pixels[j][i]);
         let mut maps = serde_json::Map::new();
-        for c in &PF_FIELDS {
+        for c in img.fields() {
             let values = mine.iter().map(|cell| c.number(img, cell));
             let units = c.unit.name(&UnitNames::si_or_model(true));
             maps.insert(c.name.into(), number_summary(units, values));
@@ -483,6 +483,15 @@ pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) ->
                 m.name,
                 m.message.as_deref().unwrap_or("no operating point")
             )),
+        }
+        if let (Some(n), Some(t)) = (m.engaged.and_then(|e| e.noise), img.temperature) {
+            s.line(format!(
+                "  {}: thermal noise at {} K, per cycle: σ(peak force) = {}, σ(deformation) = {}",
+                m.name,
+                number(t),
+                u.value(n.peak_force, "N"),
+                u.value(n.deformation, "m")
+            ));
         }
     }
     s
