@@ -481,3 +481,51 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
     );
     assert!(matches!(e, SimError::Unsupported { .. }), "{e}");
 }
+
+/// `approach --temperature` over an SLS sample (issue 79: its memory is the state's internal
+/// entry): as the Maxwell arm κ → 0 the sample is the linear law's spring α4 without a damper
+/// (`crate::contact::Zener`; the arm's dashpot and its thermal force decouple from the tip), so
+/// the lock-in's σ_A and σ_φ at every point, free and in contact, equal the linear law's within
+/// 10⁻⁶ (a 40 N/m, 300 kHz, Q = 400 lever over 5 N/m, κ = 10⁻⁹ N/m, τ_r = 0.1 µs).
+#[test]
+fn an_sls_approach_under_a_temperature_tends_to_the_linear_laws() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::{run, ApproachRequest, CurveRequest, Resolved};
+    let lever = "model = \"point-mass\"\n[cantilever]\nspring_constant = 40\n\
+                 resonance_frequency = 300e3\nquality_factor = 400\n[tip]\nradius = 10e-9\n\
+                 [drive]\nfree_amplitude = 10e-9\n[sample]\nstiffness = 5.0\n";
+    let noise = |sample: &str| -> Vec<[f64; 2]> {
+        let probe = Probe::parse(&format!("{lever}{sample}"), "sls").unwrap();
+        let model = Resolved {
+            params: probe.params,
+            probe: Some(probe),
+        };
+        let request = ApproachRequest {
+            curve: CurveRequest {
+                points: Some(8),
+                branches: false,
+                ..CurveRequest::default()
+            },
+            temperature: Some(295.0),
+            ..ApproachRequest::default()
+        };
+        let doc = run(&request, &model, &Progress::new()).unwrap().json;
+        let column = |k: &str| doc["approach"][k].as_array().unwrap().clone();
+        let (a, p) = (column("amplitude_noise"), column("phase_noise_deg"));
+        (a.iter().zip(&p))
+            .map(|(a, p)| [a.as_f64().unwrap(), p.as_f64().unwrap()])
+            .collect()
+    };
+    let linear = noise("law = \"linear\"\n");
+    let tends = noise("law = \"sls\"\nmaxwell_stiffness = 1e-9\nrelaxation_time = 1e-7\n");
+    for (i, (l, t)) in linear.iter().zip(&tends).enumerate() {
+        for c in 0..2 {
+            assert!(
+                (t[c] / l[c] - 1.0).abs() < 1e-6,
+                "point {i}: {t:?} vs {l:?}"
+            );
+        }
+    }
+    // the first two points are free, the others in contact (σ_A below the free lever's)
+    assert!(linear[7][0] < 0.5 * linear[0][0], "{linear:?}");
+}

@@ -798,3 +798,42 @@ fn a_thermal_run_beyond_the_linear_response_warns() {
         );
     }
 }
+
+/// `peakforce --temperature` over an SLS sample (issue 79: its memory is the state's internal
+/// entry, which the linear response carries): the lever of
+/// `a_temperature_gives_the_taps_thermal_noise` pressed slowly 10 nm into a standard linear
+/// solid (relaxed spring α4 = 2 N/m, Maxwell arm κ = 3 N/m with τ_r = 1 µs) rests in contact
+/// for many relaxation times of the lever and the arm, so at the top of the modulation its
+/// deviation is the equilibrium one over the lever and the arm, whose dashpot adds its own
+/// thermal force (2 k_BT η): with the potential ½k x² + ½α4 δ² + ½κ(δ − u)² (δ = x in contact)
+/// equipartition gives ⟨δx²⟩ = k_BT/(k + α4) and, for F_c = (α4 + κ)δ − κu,
+/// ⟨δF²⟩ = k_BT (α4(α4 + κ) + κk)/(k + α4). Both within 10⁻⁶.
+#[test]
+fn an_sls_sample_under_a_temperature_fluctuates_as_equipartition_gives() {
+    use afmdyn::request::{named, Resolved};
+    let text = "model = \"point-mass\"\n[cantilever]\nspring_constant = 0.4\n\
+                resonance_frequency = 70e3\nquality_factor = 2\n[tip]\nradius = 10e-9\n\
+                [sample]\nlaw = \"sls\"\nstiffness = 2.0\nmaxwell_stiffness = 3.0\n\
+                relaxation_time = 1e-6\nz_c = 10e-9\n\
+                [drive]\nmode = \"off-resonance\"\nmodulation_frequency = 700\n\
+                modulation_amplitude = 20e-9\n";
+    let probe = afmdyn::probe::Probe::parse(text, "sls").unwrap();
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let r = named::parse("peakforce", serde_json::json!({"temperature": 295.0}))
+        .unwrap()
+        .unwrap();
+    let doc = r.run(&model, &Default::default()).unwrap().document;
+    let th = &doc["thermal"];
+    let (k, a4, kappa) = (0.4_f64, 2.0_f64, 3.0_f64);
+    let kt = 1.380_649e-23 * 295.0;
+    let sigma_x = (kt / (k + a4)).sqrt();
+    let sigma_f = (kt * (a4 * (a4 + kappa) + kappa * k) / (k + a4)).sqrt();
+    let deformation = th["deformation_noise"].as_f64().unwrap();
+    let force = th["peak_force_noise"].as_f64().unwrap();
+    println!("σ_δ = {deformation:.6e} m ({sigma_x:.6e}), σ_F = {force:.6e} N ({sigma_f:.6e})");
+    assert!((deformation / sigma_x - 1.0).abs() < 1e-6, "{th}");
+    assert!((force / sigma_f - 1.0).abs() < 1e-6, "{th}");
+}

@@ -7,13 +7,17 @@
 //! equations with the saltation matrix at each switching (Leine & Nijmeijer 2004, ch. 7), driven
 //! by the fluctuation–dissipation theorem's white force, the diffusion D = GGᵀ of the
 //! stochastic step ([`crate::integrate::exact::noise`]; the region's damping under the linear
-//! law, the lever's and the medium's under a nonlinear one). Over a part (τ_a, τ_b) of the
+//! law, the lever's and the medium's under a nonlinear one). Under SLS the Maxwell arm's dashpot
+//! α6 adds its own force, white with 2 k_BT α6 (the same theorem), on its extension u:
+//! D_uu = 2 k_BT/α6, in and out of contact (α6 u̇ = κ(δ_s − u) + f, [`crate::contact::Zener`]),
+//! so that a lever held in contact fluctuates as equipartition over the lever and the arm gives,
+//! ⟨δx²⟩ = k_BT/(k + α4) (the relaxed spring). Over a part (τ_a, τ_b) of the
 //! period δz ↦ Φ δz + ξ, Φ = Φ(τ_b, τ_a) the flow's Jacobian ([`crate::maps::flow`]: the step
 //! Jacobians and the saltation matrices) and ξ Gaussian with covariance
 //! ∫ Φ(τ_b,s) D Φ(τ_b,s)ᵀ ds. That integral is exact (Van Loan's block exponential,
 //! [`crate::integrate::exact::noise`]) over a part without a switching where the motion is
-//! linear (the linear law in either region; free flight under a law that does not act outside
-//! contact); elsewhere it is the trapezoid rule h/2 (Φ D_a Φᵀ + D_b), whose relative error is
+//! linear (the linear law and SLS, with its internal state, in either region; free flight under
+//! a law that does not act outside contact); elsewhere it is the trapezoid rule h/2 (Φ D_a Φᵀ + D_b), whose relative error is
 //! (ωh)²/12 for a motion of rate ω: parts of ωh ≤ [`ETA`] = 2π/512 put it near 10⁻⁵.
 //! Observer states (a lock-in's sums) extend the deviation: the chain is y ↦ F y + ξ over the
 //! period, F the product of the parts' maps and ξ's covariance W the noise of every part carried
@@ -22,15 +26,20 @@
 //! XA + BX = C", *SIAM J. Appl. Math.* 16 (1968) 198–201); at a time t of the period the
 //! covariance is F_t Y F_tᵀ + W_t, (F_t, W_t) the chain from the period's start to t.
 //!
+//! The laws whose region depends on the history (JKR's neck and the capillary meniscus, left at
+//! another distance than they formed; the impact law's sticking) are refused ([`admits`]): the
+//! walk restarts the integrator at each part, in the region the state alone gives.
+//!
 //! This is the linear response of the measurement itself. It holds while σ stays small against
 //! the orbit's distance to grazing (a switching that the noise can remove or add is outside any
 //! linearisation), and only for a stable orbit (an unstable one has no stationary covariance).
 //! Units are the model's: τ (eq. 5), lengths in g₀, k_B T in the model's energy unit.
 
+use crate::contact::ContactLaw;
 use crate::contact::ForceEval;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::noise::{admits, diffusion, linear_part, rate_of, van_loan};
+use crate::integrate::exact::noise::{diffusion, linear_part, rate_of, van_loan};
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::flow::{flow, FlowMap};
 use crate::model::CantileverModel;
@@ -67,6 +76,27 @@ pub(crate) fn grazing(
     Ok(min_distances
         .filter(|d| (d - offset).abs() < NOISE_GRAZING * sigma)
         .count())
+}
+
+/// Whether the linear response covers `law` (module docs): every law whose region is a function
+/// of the state — those without memory, and SLS, whose memory is the state's internal entry.
+///
+/// # Errors
+/// [`SimError::Unsupported`] naming the law where the region depends on the history (JKR's
+/// neck, the capillary meniscus, left at another distance than they formed; the impact law's
+/// sticking), which the walk's restart at each part cannot carry.
+pub(crate) fn admits(law: &ContactLaw) -> Result<(), SimError> {
+    if law.hysteresis(1.0).is_none() && law.restitution().is_none() {
+        return Ok(());
+    }
+    Err(SimError::Unsupported {
+        integrator: "linear response",
+        law: law.name(),
+        hint: "the thermal noise's linear response follows the laws whose contact is a function \
+               of the state (linear, hertz, dmt, electrostatic, sls); this law's contact depends \
+               on its history (a neck or meniscus left at another distance than it formed, an \
+               impact's sticking): drop temperature for it",
+    })
 }
 
 /// The chain y ↦ F y + ξ, ξ ~ N(0, W), from the period's start to the walk's time (module docs).
@@ -116,6 +146,8 @@ pub(crate) struct Walk<'a> {
     model: &'a CantileverModel,
     /// The lever without the sample (its A_s and the diffusion's damping).
     linear: CantileverModel,
+    /// Whether the law is SLS: affine in each region with its internal state (module docs).
+    zener: bool,
     integ: Box<dyn Integrator>,
     /// D per region.
     d: [DMatrix<f64>; 2],
@@ -123,6 +155,8 @@ pub(crate) struct Walk<'a> {
     pub region: Region,
     /// The law's tip force at `tau` (its value and partials).
     pub force: ForceEval,
+    /// ∂F_c/∂u at `tau`: its rate on SLS's internal state (0 under the other laws).
+    pub force_u: f64,
     /// F's map of a part: the flow's Jacobian in its top-left block, the unit elsewhere.
     map: DMatrix<f64>,
     /// The exact noise of the last part length of each region, (ℓ, Q).
@@ -141,7 +175,8 @@ impl<'a> Walk<'a> {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `kt` (negative or not finite),
-    /// [`SimError::Unsupported`] for a law with memory ([`admits`]); the integrator's.
+    /// [`SimError::Unsupported`] for a law whose region depends on its history ([`admits`]);
+    /// the integrator's.
     pub(crate) fn new(
         model: &'a CantileverModel,
         z: &DVector<f64>,
@@ -158,15 +193,27 @@ impl<'a> Walk<'a> {
         }
         admits(&model.params().contact_law)?;
         let linear = linear_part(model)?;
-        let d = [Region::Free, Region::Contact].map(|r| diffusion(&linear, r, kt));
+        // the SLS dashpot's own force, white with 2 k_BT α6, on its extension u (module docs)
+        let zener = model.params().contact_law.internal_states() > 0;
+        let (dim, modes) = (z.len(), model.modes());
+        let d = [Region::Free, Region::Contact].map(|r| {
+            let mut d = DMatrix::zeros(dim, dim);
+            (d.view_mut((0, 0), (2 * modes, 2 * modes))).copy_from(&diffusion(&linear, r, kt));
+            if zener {
+                d[(2 * modes, 2 * modes)] = 2.0 * kt / model.params().alpha6;
+            }
+            d
+        });
         let n = z.len() + observers;
-        let (region, force) = tip_force(model, 0.0, z);
+        let (region, force, force_u) = tip_force(model, 0.0, z);
         Ok(Walk {
             integ: build(model, options, 0.0, z)?,
             linear,
+            zener,
             d,
             region,
             force,
+            force_u,
             map: DMatrix::identity(n, n),
             exact: [None, None],
             tau: 0.0,
@@ -185,8 +232,8 @@ impl<'a> Walk<'a> {
     /// The flow's.
     pub(crate) fn part(&mut self, t1: f64) -> Result<(), SimError> {
         let fl = self.flow(t1)?;
-        let (to, force) = tip_force(self.model, t1, &fl.state);
-        self.take(fl, t1, to, force);
+        let at = tip_force(self.model, t1, &fl.state);
+        self.take(fl, t1, at);
         Ok(())
     }
 
@@ -206,9 +253,9 @@ impl<'a> Walk<'a> {
                 self.tau + len
             };
             let fl = self.flow(t1)?;
-            let (to, force) = tip_force(self.model, t1, &fl.state);
-            if len * rate_of(&force, m_eff) <= ETA || len < 1e-9 * h {
-                self.take(fl, t1, to, force);
+            let at = tip_force(self.model, t1, &fl.state);
+            if len * rate_of(&at.1, m_eff) <= ETA || len < 1e-9 * h {
+                self.take(fl, t1, at);
                 return Ok(());
             }
             len *= 0.5;
@@ -223,12 +270,13 @@ impl<'a> Walk<'a> {
     /// Whether the motion in `r` is linear (module docs).
     fn linear_in(&self, r: Region) -> bool {
         let law = self.model.law();
-        law.is_affine() || (r == Region::Free && !law.acts_outside())
+        law.is_affine() || self.zener || (r == Region::Free && !law.acts_outside())
     }
 
-    /// Take the part to `t1` of flow `fl`, ending in region `to` under the tip force `force`:
-    /// F ← M F, W ← M W Mᵀ + (the part's noise, module docs) on the deviation.
-    fn take(&mut self, fl: FlowMap, t1: f64, to: Region, force: ForceEval) {
+    /// Take the part to `t1` of flow `fl`, ending in region `to` under the tip force `force`
+    /// (and its rate on u, [`tip_force`]): F ← M F, W ← M W Mᵀ + (the part's noise, module
+    /// docs) on the deviation.
+    fn take(&mut self, fl: FlowMap, t1: f64, (to, force, force_u): (Region, ForceEval, f64)) {
         let (h, from, dim) = (t1 - self.tau, self.region, fl.state.len());
         let exact = fl.switchings == 0 && from == to && self.linear_in(from);
         self.map
@@ -239,7 +287,14 @@ impl<'a> Walk<'a> {
         if exact {
             let i = from.index();
             if !matches!(&self.exact[i], Some((l, _)) if *l == h) {
-                let (_, q) = van_loan(&self.linear.dynamics(from).a, &self.d[i], h);
+                // SLS's region matrix holds its internal state's rows (the model's Jacobian,
+                // constant in each region)
+                let mut a = self.linear.dynamics(from).a.clone();
+                if self.zener {
+                    a = DMatrix::zeros(dim, dim);
+                    (self.model).jacobian_into(from, self.tau, self.state.as_slice(), &mut a);
+                }
+                let (_, q) = van_loan(&a, &self.d[i], h);
                 self.exact[i] = Some((h, q));
             }
             top += &self.exact[i].as_ref().expect("set above").1;
@@ -247,15 +302,26 @@ impl<'a> Walk<'a> {
             let j = &fl.jacobian;
             top += (j * &self.d[from.index()] * j.transpose() + &self.d[to.index()]) * (0.5 * h);
         }
-        (self.state, self.tau, self.region, self.force) = (fl.state, t1, to, force);
+        (self.state, self.tau, self.region) = (fl.state, t1, to);
+        (self.force, self.force_u) = (force, force_u);
     }
 }
 
-/// The region of (τ, `z`) on `model` and the law's tip force there.
-fn tip_force(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (Region, ForceEval) {
+/// The region of (τ, `z`) on `model`, the law's tip force there and its rate ∂F_c/∂u on SLS's
+/// internal state u (0 under the other laws): in contact F_c = α4 δ + κ(δ − u)
+/// ([`crate::contact::Zener::force`]), ∂F_c/∂δ = α4 + κ, ∂F_c/∂u = −κ.
+fn tip_force(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (Region, ForceEval, f64) {
     let r = model.region_at(tau, z);
-    (
-        r,
-        model.tip_force_eval(r, model.base_trig(tau), z.as_slice()),
-    )
+    if let (Some(zn), Region::Contact) = (model.zener(), r) {
+        let (delta, u) = (-model.v_t(tau, z), z[2 * model.modes()]);
+        let (force, d_delta) = (zn.force(true, delta, u), zn.relaxed + zn.maxwell);
+        let e = ForceEval {
+            force,
+            d_delta,
+            d_rate: 0.0,
+        };
+        return (r, e, -zn.maxwell);
+    }
+    let e = model.tip_force_eval(r, model.base_trig(tau), z.as_slice());
+    (r, e, 0.0)
 }

@@ -42,8 +42,8 @@ pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Resul
 ///
 /// # Errors
 /// As [`peakforce_probe`], the probe's models and the taps' transient estimate; as
-/// [`thermal_force`] for the temperature; [`SimError::Unsupported`] for a material's law with
-/// memory under one.
+/// [`thermal_force`] for the temperature; [`SimError::Unsupported`] under one for a material's
+/// law whose region depends on its history (JKR, capillary, impact).
 pub(crate) fn peakforce_cost(
     probe_table: &toml::Table,
     map: &SampleMap,
@@ -73,7 +73,7 @@ pub(crate) fn peakforce_cost(
     if let Some(t) = req.temperature {
         thermal_force(t, 0, Some(&background))?;
         for (_, q) in &models {
-            crate::integrate::exact::noise::admits(&q.contact_law)?;
+            crate::analysis::orbit_noise::admits(&q.contact_law)?;
             noise += super::peakforce::noise_work(q);
         }
     }

@@ -190,15 +190,16 @@ pub(crate) fn thermal_force(
 }
 
 /// k_B T at `t` in the model's energy unit of `model`'s probe, for a linear-response noise
-/// estimate of its law ([`thermal_force`]'s checks, then
-/// [`crate::integrate::exact::noise::admits`]'s; the orbit's chain holds every drive component:
-/// `crate::analysis::lock_in_noise`).
+/// estimate of its law ([`thermal_force`]'s checks, then the linear response's,
+/// `crate::analysis::orbit_noise::admits`: a law whose region depends on its history is refused;
+/// the orbit's chain holds every drive component, `crate::analysis::lock_in_noise`).
 ///
 /// # Errors
-/// As [`thermal_force`]; [`crate::SimError::Unsupported`] for a law with memory.
+/// As [`thermal_force`]; [`crate::SimError::Unsupported`] for a law whose region depends on its
+/// history (JKR, capillary, impact).
 pub(crate) fn thermal_kt(t: f64, model: &super::Resolved) -> Result<f64, crate::SimError> {
     let kt = thermal_force(t, 0, model.probe.as_ref())?.kt;
-    crate::integrate::exact::noise::admits(&model.params.contact_law)?;
+    crate::analysis::orbit_noise::admits(&model.params.contact_law)?;
     Ok(kt)
 }
 

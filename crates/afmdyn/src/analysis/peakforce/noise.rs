@@ -32,9 +32,10 @@
 //! linear response's σ within 15 %), and equal to it within its standard error with
 //! H = 10⁻²¹ J (no jump; the test below).
 //!
-//! The thermal force is the lever's and the medium's; the sample's own dissipation adds none
-//! (a force of the state), and a law with memory is refused
-//! ([`crate::integrate::exact::noise::admits`]).
+//! The thermal force is the lever's and the medium's, and SLS's dashpot's; a nonlinear
+//! sample's own dissipation adds none (a force of the state), and a law whose contact depends
+//! on its history is refused ([`crate::analysis::orbit_noise`]). Under SLS the peak force's
+//! gradient holds its rate on the dashpot's extension u, ∂F_c/∂u = −κ.
 
 use crate::analysis::orbit_noise::{Chain, Walk, ETA};
 use crate::error::SimError;
@@ -133,7 +134,7 @@ pub const MAX_PEAK_SHIFT: f64 = 1.0;
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `kt` (negative or not finite); [`SimError::Unsupported`] for
-/// a law with memory; [`SimError::Cancelled`] when the run's watched flag is set
+/// a law whose contact depends on its history (JKR, capillary, impact); [`SimError::Cancelled`] when the run's watched flag is set
 /// (`crate::analysis::progress::Progress::watch`); the integrator's and the flow's.
 pub fn tap_noise(
     model: &CantileverModel,
@@ -165,7 +166,10 @@ pub fn tap_noise(
         snap_in |= walk.region == Region::Free && -e.d_delta > stiffness;
         // F_c's gradient −(∂F/∂δ φ, ∂F/∂δ̇ φ), its rate's elastic part −∂F/∂δ φ on ȧ
         let force_grads = || {
-            let g = gradient(-e.d_delta, -e.d_rate);
+            let mut g = gradient(-e.d_delta, -e.d_rate);
+            if dim > 2 * n {
+                g[2 * n] = walk.force_u; // SLS's Maxwell arm on u
+            }
             (g, gradient(0.0, -e.d_delta))
         };
         peak.follow((tau, e.force), previous[0], &walk.chain, force_grads);

@@ -425,8 +425,9 @@ fn dissipation(t: &PeakForceTap, u: &TextUnits) -> String {
 
 /// A PeakForce image: `image.json` (`document`: `peakforce_summary`, or
 /// [`PeakForceImage::document`]), `image.nc`, the maps `image-height`, `image-modulus`,
-/// `image-adhesion`, `image-deformation`, `image-dissipation`, and the summary: every
-/// material's engaged operating point beside its true modulus.
+/// `image-adhesion`, `image-deformation`, `image-dissipation` (and with a temperature
+/// `image-peak-force-noise`), and the summary: every material's engaged operating point beside
+/// its true modulus (and its noise).
 pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
     let mut s = Presentation::default();
     s.json("image.json", document.clone());
@@ -452,7 +453,12 @@ pub(crate) fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) ->
             "Dissipation per cycle",
             "J",
         ),
-    ] {
+    ]
+    .into_iter()
+    .chain(img.temperature.map(|_| {
+        let title = "Peak-force noise σ per cycle (thermal)";
+        ("image-peak-force-noise", "peak_force_noise", title, "N")
+    })) {
         let value = |j: usize, i: usize| img.value(field, j, i);
         map_on(&mut s, (&img.x, &img.y), stem, title, unit, &value);
     }
