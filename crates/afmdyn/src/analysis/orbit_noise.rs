@@ -289,12 +289,13 @@ impl<'a> Walk<'a> {
             if !matches!(&self.exact[i], Some((l, _)) if *l == h) {
                 // SLS's region matrix holds its internal state's rows (the model's Jacobian,
                 // constant in each region)
-                let mut a = self.linear.dynamics(from).a.clone();
-                if self.zener {
-                    a = DMatrix::zeros(dim, dim);
+                let (_, q) = if self.zener {
+                    let mut a = DMatrix::zeros(dim, dim);
                     (self.model).jacobian_into(from, self.tau, self.state.as_slice(), &mut a);
-                }
-                let (_, q) = van_loan(&a, &self.d[i], h);
+                    van_loan(&a, &self.d[i], h)
+                } else {
+                    van_loan(&self.linear.dynamics(from).a, &self.d[i], h)
+                };
                 self.exact[i] = Some((h, q));
             }
             top += &self.exact[i].as_ref().expect("set above").1;

@@ -28,6 +28,13 @@
 //! - a material whose engage from far does not reach the setpoint leaves its pixels empty
 //!   (NaN, reported) and the next pixel engages again.
 //!
+//! **Thermal noise** (a request's temperature): each material's engage also gives its tap's
+//! σ of the peak force and the deformation from cycle to cycle
+//! ([`crate::analysis::peakforce::tap_noise`], in SI), and every pixel of the material takes
+//! it — a pixel kept, continued into or re-engaged is the material's operating point at the
+//! setpoint, to the feedback's tolerance — so the noise maps cost one walk over a tap per
+//! material.
+//!
 //! A uniform domain thus costs no tap per pixel and a change of material one tap, so the
 //! image costs the materials' engages plus its material changes. **A line is a task**
 //! ([`PeakForceImageStudy::line`]): it depends only on the request and its number, so the image
