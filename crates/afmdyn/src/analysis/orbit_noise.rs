@@ -17,8 +17,9 @@
 //! ∫ Φ(τ_b,s) D Φ(τ_b,s)ᵀ ds. That integral is exact (Van Loan's block exponential,
 //! [`crate::integrate::exact::noise`]) over a part without a switching where the motion is
 //! linear (the linear law and SLS, with its internal state, in either region; free flight under
-//! a law that does not act outside contact); elsewhere it is the trapezoid rule h/2 (Φ D_a Φᵀ + D_b), whose relative error is
-//! (ωh)²/12 for a motion of rate ω: parts of ωh ≤ [`ETA`] = 2π/512 put it near 10⁻⁵.
+//! a law that does not act outside contact); elsewhere it is the trapezoid rule
+//! h/2 (Φ D_a Φᵀ + D_b), whose relative error is (ωh)²/12 for a motion of rate ω: parts of
+//! ωh ≤ [`ETA`] = 2π/512 put it near 10⁻⁵.
 //! Observer states (a lock-in's sums) extend the deviation: the chain is y ↦ F y + ξ over the
 //! period, F the product of the parts' maps and ξ's covariance W the noise of every part carried
 //! through every later map. The stationary covariance Y = F Y Fᵀ + W (the discrete Lyapunov
