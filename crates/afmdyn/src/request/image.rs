@@ -35,6 +35,20 @@ pub use crate::report::image::{Image, Material, OperatingPoint, Pixel, Regime};
 
 pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
+/// The imaging mode: amplitude-modulation (AM) tapping or off-resonance (PeakForce) tapping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(rename_all = "lowercase")]
+pub enum ImageMode {
+    /// AM-AFM: the amplitude feedback at the setpoint ratio A_sp/A₀ ([`super::image`],
+    /// [`super::image_scan`]).
+    #[default]
+    Am,
+    /// PeakForce: the ideal peak-force feedback at the setpoint force (N) with an off-resonance
+    /// probe ([`super::image_peakforce`]).
+    Peakforce,
+}
+
 /// Largest number of domains of a sample map.
 pub(crate) const MAX_DOMAINS: usize = 1000;
 
@@ -128,8 +142,8 @@ impl ImageRequest {
     /// The request with the image's `temperature` as a front end takes it: a PeakForce
     /// image's ([`ImageRequest::temperature`]); an AM image's is its PI scan's, not the
     /// request's.
-    pub fn with_temperature(mut self, mode: super::image_job::ImageMode, t: Option<f64>) -> Self {
-        self.temperature = t.filter(|_| mode == super::image_job::ImageMode::Peakforce);
+    pub fn with_temperature(mut self, mode: ImageMode, t: Option<f64>) -> Self {
+        self.temperature = t.filter(|_| mode == ImageMode::Peakforce);
         self
     }
 

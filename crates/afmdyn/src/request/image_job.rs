@@ -15,7 +15,7 @@ use super::run::Resolved;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
 
-pub use super::image_options::ImageMode;
+pub use super::image::ImageMode;
 
 /// An image request with its inputs ([module docs](self)).
 #[derive(Debug, Clone, PartialEq)]

@@ -5,23 +5,9 @@
 //! check of how they combine with each other and with what else a front end was given
 //! ([`ImageOptions::check`]).
 
-use super::image::study_ratios;
+use super::image::{study_ratios, ImageMode};
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
-
-/// The imaging mode: amplitude-modulation (AM) tapping or off-resonance (PeakForce) tapping.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(rename_all = "lowercase")]
-pub enum ImageMode {
-    /// AM-AFM: the amplitude feedback at the setpoint ratio A_sp/A₀ ([`super::image`],
-    /// [`super::image_scan`]).
-    #[default]
-    Am,
-    /// PeakForce: the ideal peak-force feedback at the setpoint force (N) with an off-resonance
-    /// probe ([`super::image_peakforce`]).
-    Peakforce,
-}
 
 /// How the image holds the amplitude (or the peak force) at its setpoint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
