@@ -414,8 +414,8 @@ fn a_peakforce_image_warns_of_a_biased_modulus_as_a_single_tap_does() {
 /// `image --mode peakforce --temperature 295`: every pixel carries the σ of its material's tap
 /// at the setpoint, the single tap's of `peakforce --setpoint --temperature` on the same probe
 /// (the maps `peak_force_noise` and `deformation_noise`, each material's engaged `noise`, a
-/// `thermal` block and a summary line); a seed (the maps draw nothing) and a law with memory
-/// in a domain are refused, exit 2 naming them.
+/// `thermal` block and a summary line), a JKR domain's too (its neck carried); a seed (the
+/// maps draw nothing) and an impact domain are refused, exit 2 naming them.
 #[test]
 fn a_peakforce_image_with_a_temperature_maps_its_materials_tap_noise() {
     let (probe, blend) = (
@@ -479,20 +479,32 @@ fn a_peakforce_image_with_a_temperature_maps_its_materials_tap_noise() {
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
         &["seed = 3: only with feedback = pi"],
     );
-    // a JKR domain: its contact depends on its history
+    // a JKR domain: its neck is carried by the linear response; an impact domain's sticking is
+    // refused
     let dir = tempfile::tempdir().unwrap();
-    let jkr = dir.path().join("jkr.toml");
-    std::fs::write(
-        &jkr,
-        "size = [1.0e-6, 1.0e-6]\n[[domain]]\nname = \"soft\"\nx = [0.0, 0.5e-6]\n\
-         [domain.sample]\nlaw = \"jkr\"\nyoungs_modulus = 1e8\npoisson_ratio = 0.5\n\
-         adhesion_energy = 0.05\n",
-    )
-    .unwrap();
-    let mut args = image(&[]);
-    args[6] = jkr.to_str().unwrap().into();
+    let domain = |law: &str| {
+        let path = dir.path().join(format!("{law}.toml"));
+        let sample = match law {
+            "jkr" => {
+                "law = \"jkr\"\nyoungs_modulus = 1e8\npoisson_ratio = 0.5\nadhesion_energy = 0.05"
+            }
+            _ => "law = \"impact\"\nrestitution = 0.5",
+        };
+        let text = "size = [1.0e-6, 1.0e-6]\n[[domain]]\nname = \"soft\"\nx = [0.0, 0.5e-6]\n";
+        std::fs::write(&path, format!("{text}[domain.sample]\n{sample}\n")).unwrap();
+        let mut args = image(&[]);
+        args[6] = path.to_str().unwrap().into();
+        args
+    };
+    let args = domain("jkr");
+    let text = common::text(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        text.contains("soft: thermal noise at 295 K, per cycle: σ(peak force) = "),
+        "{text}"
+    );
+    let args = domain("impact");
     common::refused(
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        &["jkr", "temperature"],
+        &["impact", "temperature"],
     );
 }

@@ -73,6 +73,14 @@ pub trait TipSampleSystem: HybridSystem {
         let _ = (tau, z);
         None
     }
+    /// Check a start (τ, z): a finite τ, then [`TipSampleSystem::check_state`].
+    ///
+    /// # Errors
+    /// [`SimError::NotFinite`], [`SimError::StateLength`] or [`SimError::OutOfRange`].
+    fn check_time_state(&self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        crate::error::finite("initial time", tau)?;
+        self.check_state("initial state", z)
+    }
     /// Check a start (τ, z) and return its region and the state to start from:
     /// [`TipSampleSystem::check_state`], a finite τ, then
     /// [`TipSampleSystem::start_projection`] and [`HybridSystem::mode_at`].
@@ -84,8 +92,7 @@ pub trait TipSampleSystem: HybridSystem {
         tau: f64,
         z: &DVector<f64>,
     ) -> Result<(Region, DVector<f64>), SimError> {
-        crate::error::finite("initial time", tau)?;
-        self.check_state("initial state", z)?;
+        self.check_time_state(tau, z)?;
         let z = match self.start_projection(tau, z) {
             Some((projected, _)) => projected,
             None => z.clone(),

@@ -354,8 +354,8 @@ fn traces_are_the_steady_cycles_of_the_curve() {
 /// given τ_L = 1 ms. In the repulsive regime the sample stiffens the amplitude, so σ_A falls
 /// below the free lever's. Points within 5 thermal standard deviations of the surface are
 /// said to be beyond the linear response. At a setpoint the operating points carry the noise of
-/// their orbits. Refused: without a probe, a time constant without a temperature, a law with
-/// memory (JKR).
+/// their orbits. Refused: without a probe, a time constant without a temperature, the impact
+/// law.
 #[test]
 fn a_temperature_gives_the_lock_ins_thermal_noise() {
     use afmdyn::analysis::progress::Progress;
@@ -468,18 +468,24 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
         matches!(&e, SimError::OutOfRange { name, .. } if *name == "time_constant"),
         "{e}"
     );
-    let jkr = Probe::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-jkr-polymer.toml"),
-    )
-    .expect("example probe");
+    // JKR's neck is carried (`analysis::orbit_noise`); the impact law's sticking is refused
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-jkr-polymer.toml");
+    let jkr = std::fs::read_to_string(path).unwrap();
+    let (head, tail) = jkr.split_at(jkr.find("[sample]").unwrap());
+    let sample = "[sample]\nlaw = \"impact\"\nrestitution = 0.5\nz_c = 8e-9\n";
+    let text = format!("{head}{sample}{}", &tail[tail.find("[drive]").unwrap()..]);
+    let impact = Probe::parse(&text, "impact").expect("probe");
     let e = refused(
         &Resolved {
-            params: jkr.params,
-            probe: Some(jkr),
+            params: impact.params,
+            probe: Some(impact),
         },
         hot(2, None),
     );
-    assert!(matches!(e, SimError::Unsupported { .. }), "{e}");
+    assert!(
+        matches!(e, SimError::Unsupported { law: "impact", .. }),
+        "{e}"
+    );
 }
 
 /// `approach --temperature` over an SLS sample (issue 79: its memory is the state's internal

@@ -661,8 +661,8 @@ fn a_modulation_too_slow_for_the_integrator_is_refused_by_its_key() {
 /// 1951) and σ_F = k_s σ_x, within 1 %, at the peak's time; the per-cycle maxima of a thermally
 /// driven run, each the largest of many fluctuations over the flat peak, spread less (said by
 /// `thermal.flat-peak`). σ scales as √T (linear response); a sweep carries each
-/// value's noise; the laws with memory, a temperature without a probe and one out of range are
-/// refused naming it.
+/// value's noise; a JKR sample's tap has its noise; the impact law, a temperature without a
+/// probe and one out of range are refused naming it.
 #[test]
 fn a_temperature_gives_the_taps_thermal_noise() {
     use afmdyn::request::{named, Resolved};
@@ -733,7 +733,7 @@ fn a_temperature_gives_the_taps_thermal_noise() {
         .unwrap();
     let cold = cold.run(&model, &Default::default()).unwrap().document;
     assert!(cold["thermal"].is_null());
-    // refusals: out of range, without a probe's units, a law with memory
+    // refusals: out of range, without a probe's units, the impact law
     let refused = |keywords: serde_json::Value, model: &Resolved| {
         let r = named::parse("peakforce", keywords).unwrap().unwrap();
         r.run(model, &Default::default()).unwrap_err().to_string()
@@ -750,17 +750,27 @@ fn a_temperature_gives_the_taps_thermal_noise() {
     let plain = Resolved::plain(point_mass(ContactLaw::Hertz, 10.0, 20.0, 20.0, 0.9));
     let e = refused(serde_json::json!({"temperature": 295.0}), &plain);
     assert!(e.contains("temperature") && e.contains("probe"), "{e}");
-    let jkr = text.replace(
-        "law = \"linear\"\nstiffness = 2.0",
-        "law = \"jkr\"\nyoungs_modulus = 1e9\npoisson_ratio = 0.4\nadhesion_energy = 0.05",
-    );
-    let jkr = afmdyn::probe::Probe::parse(&jkr, "jkr").unwrap();
-    let jkr = Resolved {
-        params: jkr.params,
-        probe: Some(jkr),
+    // the probe over another sample
+    let over = |sample: &str| {
+        let text = text.replace("law = \"linear\"\nstiffness = 2.0", sample);
+        let probe = afmdyn::probe::Probe::parse(&text, "other").unwrap();
+        Resolved {
+            params: probe.params,
+            probe: Some(probe),
+        }
     };
-    let e = refused(serde_json::json!({"temperature": 295.0}), &jkr);
-    assert!(e.contains("jkr"), "{e}");
+    // JKR's neck is carried by the linear response (its walk, `analysis::orbit_noise`); the
+    // impact law's sticking is refused
+    let jkr =
+        over("law = \"jkr\"\nyoungs_modulus = 1e9\npoisson_ratio = 0.4\nadhesion_energy = 0.05");
+    let r = named::parse("peakforce", serde_json::json!({"temperature": 295.0}));
+    let doc = r.unwrap().unwrap().run(&jkr, &Default::default());
+    let th = &doc.unwrap().document["thermal"];
+    let sigma = th["peak_force_noise"].as_f64().unwrap();
+    assert!(sigma > 0.0 && sigma.is_finite(), "{th}");
+    let impact = over("law = \"impact\"\nrestitution = 0.5");
+    let e = refused(serde_json::json!({"temperature": 295.0}), &impact);
+    assert!(e.contains("impact") && e.contains("temperature"), "{e}");
 }
 
 /// A thermally driven run that the linear response does not reach warns

@@ -755,8 +755,8 @@ impl afmdyn::integrate::Integrator for PerStep<'_> {
     fn region(&self) -> Region {
         self.0.region()
     }
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), afmdyn::SimError> {
-        self.0.reset(tau, z)
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, r: Region) -> Result<(), afmdyn::SimError> {
+        self.0.reset_in(tau, z, r)
     }
     fn step(&mut self, tau_max: f64) -> Result<afmdyn::integrate::Step, afmdyn::SimError> {
         self.0.step(tau_max)

@@ -91,8 +91,8 @@ impl LockInNoise {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `samples` (0), `kt` or `time_constant` (negative or not
-/// finite); [`SimError::Unsupported`] for a law whose contact depends on its history (JKR, capillary, impact)
-/// (`crate::analysis::orbit_noise`); the integrator's and the flow's errors.
+/// finite); [`SimError::Unsupported`] for the impact law (`crate::analysis::orbit_noise`); the
+/// integrator's and the flow's errors.
 pub fn lock_in_noise(
     model: &CantileverModel,
     z: &DVector<f64>,

@@ -27,9 +27,13 @@
 //! XA + BX = C", *SIAM J. Appl. Math.* 16 (1968) 198–201); at a time t of the period the
 //! covariance is F_t Y F_tᵀ + W_t, (F_t, W_t) the chain from the period's start to t.
 //!
-//! The laws whose region depends on the history (JKR's neck and the capillary meniscus, left at
-//! another distance than they formed; the impact law's sticking) are refused ([`admits`]): the
-//! walk restarts the integrator at each part, in the region the state alone gives.
+//! The laws whose region depends on the history as well (JKR's neck and the capillary meniscus,
+//! left at another distance than they formed) are followed by carrying the region from part to
+//! part: each part restarts the integrator in the region the last one ended in
+//! ([`crate::maps::flow::flow_in`]), the walk's start in the one the orbit's shooting starts it
+//! in ([`crate::system::HybridSystem::mode_at`]). The impact law is refused ([`admits`]): while
+//! it sticks, the constraint's reaction takes the thermal force's part at the tip, which the
+//! diffusion here does not remove.
 //!
 //! This is the linear response of the measurement itself. It holds while σ stays small against
 //! the orbit's distance to grazing (a switching that the noise can remove or add is outside any
@@ -42,8 +46,9 @@ use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::exact::noise::{diffusion, linear_part, rate_of, van_loan};
 use crate::integrate::{build, Integrator, IntegratorOptions};
-use crate::maps::flow::{flow, FlowMap};
+use crate::maps::flow::{flow_in, FlowMap};
 use crate::model::CantileverModel;
+use crate::system::HybridSystem;
 use nalgebra::{DMatrix, DVector};
 
 /// The largest ωh of a part whose noise is summed by the trapezoid rule (module docs): 512 parts
@@ -79,24 +84,20 @@ pub(crate) fn grazing(
         .count())
 }
 
-/// Whether the linear response covers `law` (module docs): every law whose region is a function
-/// of the state — those without memory, and SLS, whose memory is the state's internal entry.
+/// Whether the linear response covers `law` (module docs): every law but the impact law.
 ///
 /// # Errors
-/// [`SimError::Unsupported`] naming the law where the region depends on the history (JKR's
-/// neck, the capillary meniscus, left at another distance than they formed; the impact law's
-/// sticking), which the walk's restart at each part cannot carry.
+/// [`SimError::Unsupported`] naming the impact law, whose sticking the walk's diffusion does not
+/// constrain (module docs).
 pub(crate) fn admits(law: &ContactLaw) -> Result<(), SimError> {
-    if law.hysteresis(1.0).is_none() && law.restitution().is_none() {
+    if law.restitution().is_none() {
         return Ok(());
     }
     Err(SimError::Unsupported {
         integrator: "linear response",
         law: law.name(),
-        hint: "the thermal noise's linear response follows the laws whose contact is a function \
-               of the state (linear, hertz, dmt, electrostatic, sls); this law's contact depends \
-               on its history (a neck or meniscus left at another distance than it formed, an \
-               impact's sticking): drop temperature for it",
+        hint: "the thermal noise's linear response follows every law but the impact law, whose \
+               sticking holds the tip against the thermal force: drop temperature for it",
     })
 }
 
@@ -176,7 +177,7 @@ impl<'a> Walk<'a> {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `kt` (negative or not finite),
-    /// [`SimError::Unsupported`] for a law whose region depends on its history ([`admits`]);
+    /// [`SimError::Unsupported`] for the impact law ([`admits`]);
     /// the integrator's.
     pub(crate) fn new(
         model: &'a CantileverModel,
@@ -206,7 +207,7 @@ impl<'a> Walk<'a> {
             d
         });
         let n = z.len() + observers;
-        let (region, force, force_u) = tip_force(model, 0.0, z);
+        let (region, force, force_u) = tip_force(model, 0.0, z, model.mode_at(0.0, z.as_slice()));
         Ok(Walk {
             integ: build(model, options, 0.0, z)?,
             linear,
@@ -233,7 +234,7 @@ impl<'a> Walk<'a> {
     /// The flow's.
     pub(crate) fn part(&mut self, t1: f64) -> Result<(), SimError> {
         let fl = self.flow(t1)?;
-        let at = tip_force(self.model, t1, &fl.state);
+        let at = tip_force(self.model, t1, &fl.state, self.integ.region());
         self.take(fl, t1, at);
         Ok(())
     }
@@ -254,7 +255,7 @@ impl<'a> Walk<'a> {
                 self.tau + len
             };
             let fl = self.flow(t1)?;
-            let at = tip_force(self.model, t1, &fl.state);
+            let at = tip_force(self.model, t1, &fl.state, self.integ.region());
             if len * rate_of(&at.1, m_eff) <= ETA || len < 1e-9 * h {
                 self.take(fl, t1, at);
                 return Ok(());
@@ -263,9 +264,10 @@ impl<'a> Walk<'a> {
         }
     }
 
-    /// The flow from the walk's time to `t1`.
+    /// The flow from the walk's time to `t1`, in the walk's region.
     fn flow(&mut self, t1: f64) -> Result<FlowMap, SimError> {
-        flow(self.integ.as_mut(), self.tau, &self.state, t1, None, false)
+        let start = (self.tau, &self.state, self.region);
+        flow_in(self.integ.as_mut(), start, t1)
     }
 
     /// Whether the motion in `r` is linear (module docs).
@@ -309,11 +311,15 @@ impl<'a> Walk<'a> {
     }
 }
 
-/// The region of (τ, `z`) on `model`, the law's tip force there and its rate ∂F_c/∂u on SLS's
+/// The law's tip force at (τ, `z`) in region `r` of `model` and its rate ∂F_c/∂u on SLS's
 /// internal state u (0 under the other laws): in contact F_c = α4 δ + κ(δ − u)
 /// ([`crate::contact::Zener::force`]), ∂F_c/∂δ = α4 + κ, ∂F_c/∂u = −κ.
-fn tip_force(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (Region, ForceEval, f64) {
-    let r = model.region_at(tau, z);
+fn tip_force(
+    model: &CantileverModel,
+    tau: f64,
+    z: &DVector<f64>,
+    r: Region,
+) -> (Region, ForceEval, f64) {
     if let (Some(zn), Region::Contact) = (model.zener(), r) {
         let (delta, u) = (-model.v_t(tau, z), z[2 * model.modes()]);
         let (force, d_delta) = (zn.force(true, delta, u), zn.relaxed + zn.maxwell);

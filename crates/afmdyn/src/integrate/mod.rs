@@ -67,8 +67,8 @@ macro_rules! variational_fields {
         fn set_variational(&mut self, on: bool) {
             self.variational = on;
         }
-        fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-            let (region, z) = self.model.checked_start(tau, z)?;
+        fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
+            self.model.check_time_state(tau, z)?;
             self.restart_in(tau, z.as_slice(), region);
             self.forget_events();
             Ok(())
@@ -226,13 +226,25 @@ pub trait Integrator: Send {
     fn state(&self) -> &DVector<f64>;
     /// Region in force at the current state.
     fn region(&self) -> Region;
-    /// Restart from (τ, z); the region is taken from the sign of V_T (eq. 8). An adaptive
-    /// integrator keeps its last step size as the first guess (a warm start), so its replay of
-    /// a flow agrees to round-off rather than bit for bit; a fixed-step one replays exactly.
+    /// Restart from (τ, z) ([`TipSampleSystem::checked_start`]: projected first where the
+    /// system does so, in the region [`crate::system::HybridSystem::mode_at`] gives, the sign
+    /// of V_T (eq. 8) but in a hysteretic law's band). An adaptive integrator keeps its last step
+    /// size as the first guess (a warm start), so its replay of a flow agrees to round-off
+    /// rather than bit for bit; a fixed-step one replays exactly.
     ///
     /// # Errors
     /// [`SimError`] for a non-finite τ or a state of the wrong length or with non-finite entries.
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError>;
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        let (region, z) = self.system().checked_start(tau, z)?;
+        self.reset_in(tau, &z, region)
+    }
+    /// Restart from (τ, z) in `region` as given, not projected: a run's own region where the
+    /// state alone does not tell it (a hysteretic law's neck or meniscus,
+    /// [`TipSampleSystem::is_hysteretic`]), as a flow continued in parts needs it.
+    ///
+    /// # Errors
+    /// As [`Integrator::reset`].
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError>;
     /// Advance by one step, never past `tau_max` (the exact propagators end on their grid point
     /// when `tau_max` is a few ulps short of it: 4 for the deterministic one; the stochastic
     /// step within 1e-9 of its step or 8 ulps).

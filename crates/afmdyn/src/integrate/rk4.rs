@@ -106,11 +106,11 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
         }
     }
 
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
+        self.model.check_time_state(tau, z)?;
         self.region = region;
         self.tau = tau;
-        self.z.copy_from(&z);
+        self.z.copy_from(z);
         Ok(())
     }
 

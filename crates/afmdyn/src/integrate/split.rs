@@ -266,8 +266,8 @@ impl Integrator for Split {
         self.adaptive.integ_mut().set_variational(on);
     }
 
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
+        self.model.check_time_state(tau, z)?;
         self.chatter.clear();
         // a new run: neither half counts the events of the last one (a chattering window
         // holding events of an earlier run, later in τ, would see a negative time span)
@@ -279,7 +279,7 @@ impl Integrator for Split {
                 self.active = Half::Exact;
             }
             Region::Contact => {
-                self.adaptive.integ_mut().reset(tau, &z)?;
+                self.adaptive.integ_mut().reset_in(tau, z, region)?;
                 self.active = Half::Adaptive;
             }
         }

@@ -62,9 +62,38 @@ pub(crate) fn flow(
     param: Option<SweepParam>,
     grazing: bool,
 ) -> Result<FlowMap, SimError> {
+    flow_from(integ, (tau0, z0, None), tau1, param, grazing)
+}
+
+/// [`flow`] from (τ0, z0) in `region` as given ([`Integrator::reset_in`]: no projection), with
+/// neither a parameter sensitivity nor the distance to grazing: a flow continued in parts,
+/// each in the region the last one ended in (a hysteretic law's neck or meniscus, which the
+/// state alone does not tell).
+///
+/// # Errors
+/// As [`flow`].
+pub(crate) fn flow_in(
+    integ: &mut dyn Integrator,
+    (tau0, z0, region): (f64, &DVector<f64>, Region),
+    tau1: f64,
+) -> Result<FlowMap, SimError> {
+    flow_from(integ, (tau0, z0, Some(region)), tau1, None, false)
+}
+
+/// [`flow`] from (τ0, z0), reset in the region given or else by [`Integrator::reset`].
+fn flow_from(
+    integ: &mut dyn Integrator,
+    (tau0, z0, region): (f64, &DVector<f64>, Option<Region>),
+    tau1: f64,
+    param: Option<SweepParam>,
+    grazing: bool,
+) -> Result<FlowMap, SimError> {
     integ.set_variational(true);
-    integ.reset(tau0, z0)?;
-    let mut product = Product::start(integ, tau0, z0, param);
+    match region {
+        Some(r) => integ.reset_in(tau0, z0, r)?,
+        None => integ.reset(tau0, z0)?,
+    }
+    let mut product = Product::start(integ, (tau0, z0, region.is_none()), param);
     let mut out = FlowMap {
         state: z0.clone(),
         jacobian: DMatrix::zeros(0, 0),
@@ -130,17 +159,17 @@ struct Product {
 }
 
 impl Product {
-    /// M = I (or the projection's Jacobian of a start inside a rigid sample, whose own
-    /// parameter dependence is not modelled: no s then), s = 0.
+    /// M = I (or, for a start that is `projected`, the projection's Jacobian of a start inside
+    /// a rigid sample, whose own parameter dependence is not modelled: no s then), s = 0.
     fn start(
         integ: &dyn Integrator,
-        tau0: f64,
-        z0: &DVector<f64>,
+        (tau0, z0, projected): (f64, &DVector<f64>, bool),
         mut param: Option<SweepParam>,
     ) -> Self {
         let dim = z0.len();
         // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
-        let jac = match integ.system().start_projection(tau0, z0) {
+        let projection = projected.then(|| integ.system().start_projection(tau0, z0));
+        let jac = match projection.flatten() {
             Some((_, p)) => {
                 // the projection's own parameter dependence is not modelled
                 param = None;

@@ -42,8 +42,8 @@ pub(crate) fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Resul
 ///
 /// # Errors
 /// As [`peakforce_probe`], the probe's models and the taps' transient estimate; as
-/// [`thermal_force`] for the temperature; [`SimError::Unsupported`] under one for a material's
-/// law whose region depends on its history (JKR, capillary, impact).
+/// [`thermal_force`] for the temperature; [`SimError::Unsupported`] under one for a material of
+/// the impact law.
 pub(crate) fn peakforce_cost(
     probe_table: &toml::Table,
     map: &SampleMap,

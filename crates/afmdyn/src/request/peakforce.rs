@@ -80,9 +80,8 @@ request! {
         /// response about the steady tap ([`crate::analysis::peakforce::tap_noise`]; the
         /// per-cycle maxima's where the peak is sharp); a sweep gains them as the channels
         /// `peak_force_noise` and `deformation_noise` of every value (the block is the
-        /// single-tap blocks' tap's). Needs the probe's SI units; the laws whose contact depends
-        /// on its history (JKR, capillary, impact) are refused (SLS's dashpot adds its own
-        /// thermal force).
+        /// single-tap blocks' tap's). Needs the probe's SI units; the impact law is refused (its
+        /// sticking holds the tip against the thermal force; SLS's dashpot adds its own).
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
         /// Modulation cycles of a thermally driven run of the tap (with `temperature`;
@@ -176,7 +175,7 @@ impl PeakForceRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe);
-    /// [`SimError::Unsupported`] for a law whose contact depends on its history (JKR, capillary, impact).
+    /// [`SimError::Unsupported`] for the impact law.
     pub(crate) fn thermal(&self, model: &Resolved) -> Result<Option<f64>, SimError> {
         let cycles = self.thermal_cycles.map(|n| n as f64);
         let kt =

@@ -33,8 +33,9 @@
 //! H = 10⁻²¹ J (no jump; the test below).
 //!
 //! The thermal force is the lever's and the medium's, and SLS's dashpot's; a nonlinear
-//! sample's own dissipation adds none (a force of the state), and a law whose contact depends
-//! on its history is refused ([`crate::analysis::orbit_noise`]). Under SLS the peak force's
+//! sample's own dissipation adds none (a force of the state), and the impact law is refused
+//! ([`crate::analysis::orbit_noise`]; JKR's neck and the capillary meniscus are carried from
+//! part to part). Under SLS the peak force's
 //! gradient holds its rate on the dashpot's extension u, ∂F_c/∂u = −κ.
 
 use crate::analysis::orbit_noise::{Chain, Walk, ETA};
@@ -134,7 +135,7 @@ pub const MAX_PEAK_SHIFT: f64 = 1.0;
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `kt` (negative or not finite); [`SimError::Unsupported`] for
-/// a law whose contact depends on its history (JKR, capillary, impact); [`SimError::Cancelled`] when the run's watched flag is set
+/// the impact law; [`SimError::Cancelled`] when the run's watched flag is set
 /// (`crate::analysis::progress::Progress::watch`); the integrator's and the flow's.
 pub fn tap_noise(
     model: &CantileverModel,

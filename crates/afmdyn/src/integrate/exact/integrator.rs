@@ -17,8 +17,8 @@ impl Integrator for ExactPropagator {
         "exact"
     }
 
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
+        self.model.check_time_state(tau, z)?;
         self.restart_in(tau, z.as_slice(), region, false);
         Ok(())
     }

@@ -1013,13 +1013,13 @@ impl Integrator for ThermalExact {
         }
     }
 
-    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        let (region, z) = self.model.checked_start(tau, z)?;
+    fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
+        self.model.check_time_state(tau, z)?;
         let j = self.det.grid.next_index(tau) - 1;
         self.at = (self.det.grid.tau(j) == tau).then_some((j, 0));
         self.tau = tau;
         self.sc = (self.model.omega() * tau).sin_cos();
-        self.z = z;
+        self.z = z.clone();
         self.region = region;
         self.points.clear();
         Ok(())
