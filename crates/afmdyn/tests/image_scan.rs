@@ -596,10 +596,10 @@ fn a_thermal_scan_is_its_seeds() {
         .fold(0.0, f64::max);
     println!("DMT at T → 0: heights {bias:.3} pm from the deterministic scan's");
     assert!(bias < 5.0, "{bias} pm");
-    // a law with memory (JKR) has no stochastic step: refused naming it
-    let jkr = SampleMap::parse(
+    // SLS (its dashpot's extension a state of its own) has no stochastic step: refused naming it
+    let sls = SampleMap::parse(
         "size = [1e-6, 0]\n[[domain]]\nname = \"j\"\nx = [3e-7, 5e-7]\n[domain.sample]\n\
-         law = \"jkr\"\nyoungs_modulus = 4e9\npoisson_ratio = 0.33\nadhesion_energy = 0.05\n",
+         law = \"sls\"\nstiffness = 2.0\nmaxwell_stiffness = 3.0\nrelaxation_time = 1e-6\n",
         "<test>",
     )
     .unwrap();
@@ -607,8 +607,8 @@ fn a_thermal_scan_is_its_seeds() {
         temperature: Some(295.0),
         ..PiScan::default()
     };
-    match pi_image(&dmt, &jkr, &short, &s, Some(1), &Progress::new()) {
-        Err(SimError::Unsupported { law, .. }) => assert_eq!(law, "jkr"),
+    match pi_image(&dmt, &sls, &short, &s, Some(1), &Progress::new()) {
+        Err(SimError::Unsupported { law, .. }) => assert_eq!(law, "sls"),
         other => panic!("{:?}", other.map(|_| ())),
     }
 }

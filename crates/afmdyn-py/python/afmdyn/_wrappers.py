@@ -104,10 +104,11 @@ def simulate(
             the deterministic run. Each mode's equation then carries the white force the
             fluctuation–dissipation theorem gives for its damping (the lever's, the
             medium's, in contact the linear law's dashpot), advanced by the exact stochastic
-            step of the linear law, or the exponential Euler step of Hertz, DMT and the
-            electrostatic law (``crate::integrate::exact::noise``). Needs the probe's SI
-            units (``--probe``); the laws with memory (JKR, capillary, SLS, impact) are
-            refused; not with ``energy_balance`` or a multifrequency drive.
+            step of the linear law, or the exponential Euler step of Hertz, DMT, the
+            electrostatic law, JKR and the capillary meniscus (their region the run's own;
+            ``crate::integrate::exact::noise``). Needs the probe's SI units (``--probe``);
+            SLS and the impact law are refused; not with ``energy_balance`` or a
+            multifrequency drive.
         tolerance: Relative and absolute tolerance of the adaptive integrator.
         transient: Drive periods discarded before recording, >= 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a

@@ -49,9 +49,10 @@ request! {
         /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
         /// for its damping (the lever's, the medium's, in contact the linear law's dashpot),
         /// advanced by the exact stochastic step of the linear law, or the exponential Euler step
-        /// of Hertz, DMT and the electrostatic law (`crate::integrate::exact::noise`). Needs the
-        /// probe's SI units (`--probe`); the laws with memory (JKR, capillary, SLS, impact) are
-        /// refused; not with `energy_balance` or a multifrequency drive.
+        /// of Hertz, DMT, the electrostatic law, JKR and the capillary meniscus (their region
+        /// the run's own; `crate::integrate::exact::noise`). Needs the probe's SI units
+        /// (`--probe`); SLS and the impact law are refused; not with `energy_balance` or a
+        /// multifrequency drive.
         pub temperature: Option<f64>,
         /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
         /// a function of its seed, whatever the threads.

@@ -45,9 +45,11 @@
 //! ladder; a piece to a time off it (the run's end) has its own ladder, built on demand.
 //!
 //! # Nonlinear laws: the exponential Euler step
-//! For a law that is not piecewise linear but has no memory (Hertz, DMT, the electrostatic
-//! law: a force F_c(δ, δ̇) of the state, the contact where V_T ≤ 0) the step is the exponential
-//! Euler scheme over the exact linear part: on each piece the tip force is taken as its value
+//! For a law that is not piecewise linear but whose force is one of the state in each region
+//! (Hertz, DMT, the electrostatic law: a force F_c(δ, δ̇), the contact where V_T ≤ 0; JKR and
+//! the capillary meniscus too, whose contact, formed at V_T = 0, is left at V_T = |δ_f| > 0,
+//! the gap in contact being |δ_f| − V_T and the region the run's own) the step is the
+//! exponential Euler scheme over the exact linear part: on each piece the tip force is taken as its value
 //! at the piece's start and the drift's rate of it there, F(τ₀ + s) ≈ F₀ + F₁ s
 //! (F₁ = ∂F_c/∂δ δ̇ + ∂F_c/∂δ̇ δ̈, δ̈ the drift's), so that the piece is the free lever's linear
 //! stochastic system with an affine force at the tip, advanced exactly as above about its
@@ -156,23 +158,23 @@ pub(crate) fn holding_samples(steps: usize, samples: usize) -> usize {
 }
 
 /// Whether the stochastic step can integrate `law`: the piecewise-linear law exactly, a law
-/// without memory (no hysteresis, internal state or impact: Hertz, DMT, electrostatic) by the
-/// exponential Euler step (module docs).
+/// whose force is a function of the state in each region (Hertz, DMT, electrostatic, and the
+/// hysteretic JKR and capillary laws, whose region the run carries) by the exponential Euler
+/// step (module docs).
 ///
 /// # Errors
-/// [`SimError::Unsupported`] naming the law (JKR, capillary, SLS and impact: their contact
-/// depends on its history, whose stochastic integration is not built).
+/// [`SimError::Unsupported`] naming the law (SLS, whose dashpot's extension is a state of its
+/// own, and impact, whose state jumps and sticks: their stochastic integration is not built).
 pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
-    let memory =
-        law.hysteresis(1.0).is_some() || law.internal_states() > 0 || law.restitution().is_some();
-    if law.is_affine() || !memory {
+    if law.internal_states() == 0 && law.restitution().is_none() {
         return Ok(());
     }
     Err(SimError::Unsupported {
         integrator: "exact-thermal",
         law: law.name(),
-        hint: "thermal noise (temperature) is simulated for the laws without memory (linear, \
-               hertz, dmt, electrostatic); this law's contact depends on its history: drop \
+        hint: "thermal noise (temperature) is simulated for the laws whose force is a function \
+               of the state (linear, hertz, dmt, electrostatic, jkr, capillary); this law's \
+               sample has a state of its own (sls) or jumps and sticks (impact): drop \
                temperature for it",
     })
 }
@@ -702,18 +704,19 @@ impl ThermalExact {
         }
     }
 
-    /// The sign of the gap in region `r`: V_T is the gap in free flight, −V_T in contact.
-    fn sign(r: Region) -> f64 {
-        if r == Region::Free {
-            1.0
-        } else {
-            -1.0
-        }
+    /// The gap of z in region `r`, (sin, cos) Ωτ = `sc`: V_T in free flight, −V_T in contact,
+    /// |δ_f| − V_T there under a hysteretic law (JKR's neck, the capillary meniscus: left at
+    /// V_T = |δ_f|, [`crate::contact::ContactLaw::release_distance`]).
+    fn gap(&self, r: Region, sc: (f64, f64), z: &DVector<f64>) -> f64 {
+        self.gap_of(r, tip_v_t(self.model(), z.as_slice(), sc).0)
     }
 
-    /// The gap ±V_T (+ free, − in contact) of z in region `r`, (sin, cos) Ωτ = `sc`.
-    fn gap(&self, r: Region, sc: (f64, f64), z: &DVector<f64>) -> f64 {
-        Self::sign(r) * tip_v_t(self.model(), z.as_slice(), sc).0
+    /// [`ThermalExact::gap`] in region `r` at V_T = `v`.
+    fn gap_of(&self, r: Region, v: f64) -> f64 {
+        match r {
+            Region::Free => v,
+            Region::Contact => self.model().release_distance() - v,
+        }
     }
 
     /// The gap of the bridge's mean at the middle of an interval of rung `rung` of region `r`
@@ -733,7 +736,7 @@ impl ThermalExact {
         let [c1, c2] = self.shift(tm);
         let forced = c1 * self.unit[0].1 + c2 * self.unit[1].1;
         let w = w0 + ws * scm.0 + wc * scm.1 + forced + u.dot(da) + v.dot(db);
-        Self::sign(r) * self.model().v_t_at(scm, [w, 0.0, 0.0])[0]
+        self.gap_of(r, self.model().v_t_at(scm, [w, 0.0, 0.0])[0])
     }
 
     /// How near to a time `t` a lattice point is taken for it: 1e-9 h, or [`ROUNDING_ULPS`]
