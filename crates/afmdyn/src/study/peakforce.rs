@@ -581,7 +581,8 @@ pub(crate) fn linear_warnings(taps: &[(TapNoise, f64, f64)], snap_in: bool) -> V
         warnings.push(warning!(
             "thermal.flat-peak",
             "Read peak_force_noise and deformation_noise as the channels' σ at the peak's time; \
-             a thermally driven run (thermal_cycles) measures the per-cycle maxima.",
+             a thermally driven run of the tap (peakforce's thermal_cycles, --thermal-cycles) \
+             measures the per-cycle maxima.",
             "the tap's peak is flat against the thermal noise (the noise's slope shifts the \
              per-cycle maximum by more than {MAX_PEAK_SHIFT} of its σ): each cycle's peak is \
              then the largest of several fluctuations, narrower in spread and higher than the \
@@ -592,7 +593,7 @@ pub(crate) fn linear_warnings(taps: &[(TapNoise, f64, f64)], snap_in: bool) -> V
         warnings.push(warning!(
             "thermal.snap-in",
             "Read the σ as the typical cycle's spread; a thermally driven run of the tap \
-             (thermal_cycles, --thermal-cycles) measures the rare hard taps.",
+             (peakforce's thermal_cycles, --thermal-cycles) measures the rare hard taps.",
             "the tap jumps to contact (out of contact the attraction's stiffness passes the \
              lever's): the noise moves the jump nonlinearly, so the linear response gives the \
              Gaussian core of the peaks' spread, not its tail of rare hard taps (8× the variance \
