@@ -11,8 +11,9 @@
 //! Prints one line of JSON: seconds of each, their ratio, the cycles the loop ran and the
 //! largest difference of their frequency shifts relative to the largest shift.
 
+use afmdyn::analysis::fm::LoopSpec;
 use afmdyn::analysis::fm::{fm_curve, FmSpec};
-use afmdyn::analysis::fm_loop::{fm_loop, LoopSpec};
+use afmdyn::analysis::fm_loop::fm_loop;
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
 use std::path::Path;

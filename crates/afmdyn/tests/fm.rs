@@ -241,7 +241,8 @@ fn high_q_curve_reaches_the_contact_edge() {
 /// steady state: the same frequency shift within what the settling tolerance allows.
 #[test]
 fn the_time_domain_loop_settles_on_the_exact_steady_state() {
-    use afmdyn::analysis::fm_loop::{fm_loop, LoopSpec};
+    use afmdyn::analysis::fm::LoopSpec;
+    use afmdyn::analysis::fm_loop::fm_loop;
     let text = PROBE.replace("quality_factor = 1e4", "quality_factor = 400");
     let probe = Probe::parse(&text, "q400").unwrap();
     let z_c: Vec<f64> = (0..5).map(|i| 14e-9 - i as f64 * 0.8e-9).collect();

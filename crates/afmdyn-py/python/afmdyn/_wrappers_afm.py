@@ -635,7 +635,7 @@ def fm(
         bandwidth: The loops' equivalent noise bandwidth B (Hz; with ``temperature``), > 0
             and at most ≈ π f_K/(4Q_K) (a gain min(π/Q_K, 1) per cycle, where they would
             outrun the lever); ``None``: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K)
-            (``analysis::fm_loop::LoopSpec``).
+            (``analysis::fm::LoopSpec``).
         from_: First z_c of the approach (default: where the frequency shift has decayed to
             0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower
             turning point at A, for the laws without a force before contact).

@@ -63,6 +63,34 @@ pub mod noise;
 mod solver;
 use solver::{predict, Locked, Solver};
 
+/// The FM loops' gains and limits: the time-domain loop's ([`super::fm_loop`]) and the closed
+/// loop's of the noise's linear response ([`noise`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LoopSpec {
+    /// g_φ: the PLL's gain per cycle ([`super::fm_loop`]).
+    pub phase_gain: f64,
+    /// g_A: the amplitude controller's gain per cycle.
+    pub amplitude_gain: f64,
+    /// Most cycles per value.
+    pub max_cycles: usize,
+    /// Settling tolerance of |A₁/A − 1| and |φ₁ − φ_set| (rad).
+    pub tolerance: f64,
+}
+
+impl LoopSpec {
+    /// Gains a third of the stability bound π/Q_K (and at most 0.3), at most 200 Q_K cycles per
+    /// value, tolerance 1e-7.
+    pub fn new(quality_factor: f64) -> Self {
+        let g = (std::f64::consts::PI / (3.0 * quality_factor)).min(0.3);
+        LoopSpec {
+            phase_gain: g,
+            amplitude_gain: g,
+            max_cycles: (200.0 * quality_factor).clamp(1e3, 1e7) as usize,
+            tolerance: 1e-7,
+        }
+    }
+}
+
 /// Default tolerance of the two loop conditions: |A₁/A − 1| and |φ₁ − φ_set| (rad).
 pub(crate) const DEFAULT_LOOP_TOLERANCE: f64 = 1e-9;
 /// Default tolerance of the integrator of the orbits ([`FmSpec::new`]).

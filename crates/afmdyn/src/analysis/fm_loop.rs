@@ -17,7 +17,7 @@
 //! the loop stable ([`LoopSpec::new`]). A value is settled when both errors stay below the
 //! tolerance for `SETTLED_CYCLES` cycles in a row.
 
-use super::fm::{fm_reference, phase_error, FmSpec};
+use super::fm::{fm_reference, phase_error, FmSpec, LoopSpec};
 use super::observables::{observe, ObservableOptions};
 use super::progress::Progress;
 use crate::error::SimError;
@@ -28,33 +28,6 @@ use serde::{Deserialize, Serialize};
 
 /// Cycles in a row with both errors below the tolerance for a value to count as settled.
 pub(crate) const SETTLED_CYCLES: usize = 10;
-
-/// The loop's gains and limits.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LoopSpec {
-    /// g_φ: the PLL's gain per cycle (module docs).
-    pub phase_gain: f64,
-    /// g_A: the amplitude controller's gain per cycle.
-    pub amplitude_gain: f64,
-    /// Most cycles per value.
-    pub max_cycles: usize,
-    /// Settling tolerance of |A₁/A − 1| and |φ₁ − φ_set| (rad).
-    pub tolerance: f64,
-}
-
-impl LoopSpec {
-    /// Gains a third of the stability bound π/Q_K (and at most 0.3), at most 200 Q_K cycles per
-    /// value, tolerance 1e-7.
-    pub fn new(quality_factor: f64) -> Self {
-        let g = (std::f64::consts::PI / (3.0 * quality_factor)).min(0.3);
-        LoopSpec {
-            phase_gain: g,
-            amplitude_gain: g,
-            max_cycles: (200.0 * quality_factor).clamp(1e3, 1e7) as usize,
-            tolerance: 1e-7,
-        }
-    }
-}
 
 /// The loop's state at the end of one value.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

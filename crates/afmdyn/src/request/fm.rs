@@ -53,7 +53,7 @@ request! {
         pub temperature: Option<f64>,
         /// The loops' equivalent noise bandwidth B (Hz; with `temperature`), > 0 and at most
         /// ≈ π f_K/(4Q_K) (a gain min(π/Q_K, 1) per cycle, where they would outrun the lever);
-        /// `None`: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K) ([`crate::analysis::fm_loop::LoopSpec`]).
+        /// `None`: gains π/(3Q_K) per cycle, B ≈ π f_K/(12 Q_K) ([`crate::analysis::fm::LoopSpec`]).
         #[serde(skip_serializing_if = "Option::is_none")]
         #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
         pub bandwidth: Option<f64>,

@@ -4,8 +4,8 @@
 //! (g₀, Ω, F̃).
 
 use crate::analysis::fm::noise::{curve_noise, loop_bandwidth, loop_gain, MAX_LOOP_GAIN};
+use crate::analysis::fm::LoopSpec;
 use crate::analysis::fm::{fm_curve, fm_reference, FmCurve, FmPoint, FmReference, FmSpec};
-use crate::analysis::fm_loop::LoopSpec;
 use crate::analysis::orbit_noise::{grazing, NOISE_GRAZING};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;

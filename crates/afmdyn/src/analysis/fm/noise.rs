@@ -31,9 +31,8 @@
 //! response does, and only for a stable closed loop (NaN otherwise). Units are the model's: Ω
 //! in units of the τ scale, lengths in g₀, k_B T in the model's energy unit.
 
-use super::{FmCurve, FmPoint, FmReference};
+use super::{FmCurve, FmPoint, FmReference, LoopSpec};
 use crate::analysis::am_loop::demodulate_period_stepped;
-use crate::analysis::fm_loop::LoopSpec;
 use crate::analysis::lock_in_noise::period_chain;
 use crate::analysis::orbit_noise::Chain;
 use crate::error::SimError;
