@@ -474,14 +474,7 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
     let (head, tail) = jkr.split_at(jkr.find("[sample]").unwrap());
     let sample = "[sample]\nlaw = \"impact\"\nrestitution = 0.5\nz_c = 8e-9\n";
     let text = format!("{head}{sample}{}", &tail[tail.find("[drive]").unwrap()..]);
-    let impact = Probe::parse(&text, "impact").expect("probe");
-    let e = refused(
-        &Resolved {
-            params: impact.params,
-            probe: Some(impact),
-        },
-        hot(2, None),
-    );
+    let e = refused(&super::common::resolved(&text, "impact"), hot(2, None));
     assert!(
         matches!(e, SimError::Unsupported { law: "impact", .. }),
         "{e}"

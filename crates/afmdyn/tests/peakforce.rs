@@ -438,11 +438,7 @@ fn peakforce_request_by_name_reports_si_channels() {
     // first natural frequency is ≈ 3.516 in its own units, not 1)
     let ratio = out.document["modulation"]["f0_over_fm"].as_f64().unwrap();
     assert!((ratio / 35.0 - 1.0).abs() < 1e-9, "{ratio}");
-    let beam = afmdyn::probe::Probe::parse(&text, "air").unwrap();
-    let beam = Resolved {
-        params: beam.params,
-        probe: Some(beam),
-    };
+    let beam = super::common::resolved(&text, "air");
     let doc = r.run(&beam, &Default::default()).unwrap().document;
     let ratio = doc["modulation"]["f0_over_fm"].as_f64().unwrap();
     assert!((ratio / 35.0 - 1.0).abs() < 1e-6, "{ratio}");
@@ -471,15 +467,11 @@ fn peakforce_request_by_name_reports_si_channels() {
 /// cycle's samples is refused naming `filter_cutoff`.
 #[test]
 fn peakforce_filter_on_the_measured_force() {
-    use afmdyn::request::{named, Resolved};
+    use afmdyn::request::named;
     let text = std::fs::read_to_string(AIR)
         .unwrap()
         .replace("model = \"beam\"\nmodes = 3", "model = \"point-mass\"");
-    let probe = afmdyn::probe::Probe::parse(&text, "air-pm").unwrap();
-    let model = Resolved {
-        params: probe.params,
-        probe: Some(probe),
-    };
+    let model = super::common::resolved(&text, "air-pm");
     let run = |json| {
         named::parse("peakforce", json)
             .unwrap()
@@ -671,11 +663,7 @@ fn a_temperature_gives_the_taps_thermal_noise() {
                 [sample]\nlaw = \"linear\"\nstiffness = 2.0\nz_c = 10e-9\n\
                 [drive]\nmode = \"off-resonance\"\nmodulation_frequency = 700\n\
                 modulation_amplitude = 20e-9\n";
-    let probe = afmdyn::probe::Probe::parse(text, "pressed").unwrap();
-    let model = Resolved {
-        params: probe.params,
-        probe: Some(probe),
-    };
+    let model = super::common::resolved(text, "pressed");
     let run = |t: f64| {
         let r = named::parse("peakforce", serde_json::json!({"temperature": t}))
             .unwrap()
@@ -753,11 +741,7 @@ fn a_temperature_gives_the_taps_thermal_noise() {
     // the probe over another sample
     let over = |sample: &str| {
         let text = text.replace("law = \"linear\"\nstiffness = 2.0", sample);
-        let probe = afmdyn::probe::Probe::parse(&text, "other").unwrap();
-        Resolved {
-            params: probe.params,
-            probe: Some(probe),
-        }
+        super::common::resolved(&text, "other")
     };
     // JKR's neck is carried by the linear response (its walk, `analysis::orbit_noise`); the
     // impact law's sticking is refused
@@ -783,7 +767,7 @@ fn a_temperature_gives_the_taps_thermal_noise() {
 /// linear response alike) they agree too (0.274 ± 0.006 against 0.280 nN), without it.
 #[test]
 fn a_thermal_run_beyond_the_linear_response_warns() {
-    use afmdyn::request::{named, Resolved};
+    use afmdyn::request::named;
     let dmt = |h: f64| {
         format!(
             "law = \"dmt\"\nyoungs_modulus = 4e9\npoisson_ratio = 0.33\nhamaker = {h}\nz_c = 18e-9"
@@ -802,11 +786,7 @@ fn a_thermal_run_beyond_the_linear_response_warns() {
              [sample]\n{sample}\n[drive]\nmode = \"off-resonance\"\n\
              modulation_frequency = 7e3\nmodulation_amplitude = 20e-9\n"
         );
-        let probe = afmdyn::probe::Probe::parse(&text, "polystyrene").unwrap();
-        let model = Resolved {
-            params: probe.params,
-            probe: Some(probe),
-        };
+        let model = super::common::resolved(&text, "polystyrene");
         let r = serde_json::json!({"temperature": 295.0, "thermal_cycles": 1000});
         let r = named::parse("peakforce", r).unwrap().unwrap();
         let doc = r.run(&model, &Default::default()).unwrap().document;
@@ -835,18 +815,14 @@ fn a_thermal_run_beyond_the_linear_response_warns() {
 /// ⟨δF²⟩ = k_BT (α4(α4 + κ) + κk)/(k + α4). Both within 10⁻⁶.
 #[test]
 fn an_sls_sample_under_a_temperature_fluctuates_as_equipartition_gives() {
-    use afmdyn::request::{named, Resolved};
+    use afmdyn::request::named;
     let text = "model = \"point-mass\"\n[cantilever]\nspring_constant = 0.4\n\
                 resonance_frequency = 70e3\nquality_factor = 2\n[tip]\nradius = 10e-9\n\
                 [sample]\nlaw = \"sls\"\nstiffness = 2.0\nmaxwell_stiffness = 3.0\n\
                 relaxation_time = 1e-6\nz_c = 10e-9\n\
                 [drive]\nmode = \"off-resonance\"\nmodulation_frequency = 700\n\
                 modulation_amplitude = 20e-9\n";
-    let probe = afmdyn::probe::Probe::parse(text, "sls").unwrap();
-    let model = Resolved {
-        params: probe.params,
-        probe: Some(probe),
-    };
+    let model = super::common::resolved(text, "sls");
     let r = named::parse("peakforce", serde_json::json!({"temperature": 295.0}))
         .unwrap()
         .unwrap();

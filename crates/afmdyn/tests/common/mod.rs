@@ -30,6 +30,16 @@ pub fn regressions_beside_the_source() -> Option<Box<dyn FailurePersistence>> {
     )))
 }
 
+/// The model of the probe file's `text` (`origin` in its errors) with its SI units: what a
+/// request runs on when given a probe.
+pub fn resolved(text: &str, origin: &str) -> afmdyn::request::Resolved {
+    let probe = afmdyn::probe::Probe::parse(text, origin).expect("probe");
+    afmdyn::request::Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    }
+}
+
 /// The complex amplitude â of region `r`'s linear response a = Re(â e^{iΩτ}) to its harmonic
 /// forcing: (K − Ω²M + iΩC) â = F_cos − i F_sin (eq. 10, shape `[N]`).
 pub fn complex_response(model: &CantileverModel, r: Region) -> DVector<Complex<f64>> {
