@@ -699,6 +699,15 @@ fn image_is_refused_before_its_directory() {
         err.contains("gains = K_I = 1e12") && !err.contains("scan_rate ="),
         "{err}"
     );
+    // a multifrequency probe (one further component, examples/probe-bimodal.toml): an image is
+    // recorded with one drive frequency
+    let mut args = with(&["--feedback", "pi"]);
+    args[2] = "examples/probe-bimodal.toml".into();
+    let err = refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out);
+    assert!(
+        err.contains("probe = a multifrequency drive") && err.contains("one drive frequency"),
+        "{err}"
+    );
 }
 
 /// `image --files`: `data` writes the document and the dataset without figures, `none`

@@ -107,8 +107,8 @@ def simulate(
             step of the linear law, or the exponential Euler step of Hertz, DMT, the
             electrostatic law, JKR and the capillary meniscus (their region the run's own;
             ``crate::integrate::exact::noise``). Needs the probe's SI units (``--probe``);
-            SLS and the impact law are refused; not with ``energy_balance`` or a
-            multifrequency drive.
+            SLS and the impact law are refused; not with ``energy_balance``. Under a
+            multifrequency drive each further component adds its particular solution.
         tolerance: Relative and absolute tolerance of the adaptive integrator.
         transient: Drive periods discarded before recording, >= 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a

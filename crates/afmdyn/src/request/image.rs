@@ -247,7 +247,7 @@ pub(crate) const MAX_IMAGE_BYTES: f64 = 1.1 * super::limits::GIB;
 pub(crate) fn background_probe(probe_table: &toml::Table) -> Result<Probe, SimError> {
     let background =
         Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
-    if background.components.len() > 1 {
+    if !background.components.is_empty() {
         return Err(SimError::out_of_range(
             "probe",
             "a multifrequency drive",

@@ -51,8 +51,8 @@ request! {
         /// advanced by the exact stochastic step of the linear law, or the exponential Euler step
         /// of Hertz, DMT, the electrostatic law, JKR and the capillary meniscus (their region
         /// the run's own; `crate::integrate::exact::noise`). Needs the probe's SI units
-        /// (`--probe`); SLS and the impact law are refused; not with `energy_balance` or a
-        /// multifrequency drive.
+        /// (`--probe`); SLS and the impact law are refused; not with `energy_balance`. Under a
+        /// multifrequency drive each further component adds its particular solution.
         pub temperature: Option<f64>,
         /// The seed of the thermal force's random stream (with `temperature`; default 0): a run is
         /// a function of its seed, whatever the threads.
@@ -219,7 +219,10 @@ impl SimulateRequest {
                 "thermal noise is advanced by the exact stochastic step: auto or exact",
             ));
         }
-        opts.steps_per_period = holding_samples(opts.steps_per_period, self.samples_per_period);
+        // the grid spans the system's period: a multifrequency drive's common period holds
+        // its drive periods' samples
+        let held = self.samples_per_period * crate::integrate::exact::noise::drive_periods(model);
+        opts.steps_per_period = holding_samples(opts.steps_per_period, held);
         let mut it = ThermalExact::new(model, &opts, force)?.holding(self.samples_per_period);
         it.reset(0.0, z0)?;
         Ok(Box::new(it))

@@ -12,8 +12,10 @@
 //! (A P + P Aᵀ + GGᵀ = 0), the equipartition `crate::analysis::thermal` reports.
 //!
 //! # The exact step
-//! With δz = z − z_p(τ) (z_p the region's periodic particular solution, as the deterministic
-//! propagator's, [`super::ExactPropagator`]) the step of length ℓ is
+//! With δz = z − z_p(τ) (z_p the region's periodic particular solution: the deterministic
+//! propagator's of the primary drive, [`super::ExactPropagator`], plus that of each further
+//! component of a multifrequency drive, a tip force F̃ cos(ωτ + θ) whose response is
+//! Re[F̃ (iωI − A_s)⁻¹ (0, M⁻¹φ) e^{i(ωτ + θ)}]) the step of length ℓ is
 //! δz(τ + ℓ) = Φ(ℓ) δz(τ) + w, w ~ N(0, Q(ℓ)), Φ(ℓ) = e^{A_s ℓ}, Q(ℓ) = ∫₀^ℓ e^{A_s u} GGᵀ
 //! e^{A_sᵀ u} du, exact at any ℓ (the free lever's thermal motion is exact whatever the grid).
 //! Φ and Q come from one block exponential, exp([[−A, GGᵀ], [0, Aᵀ]] ℓ) = [[·, F₁₂], [0, F₂₂]]:
@@ -157,6 +159,14 @@ pub(crate) fn holding_samples(steps: usize, samples: usize) -> usize {
     a / crate::params::gcd(a as u64, s as u64) as usize * s
 }
 
+/// The drive periods 2π/Ω in the system's period [`CantileverModel::period`], which the grid
+/// spans: 1, or a multifrequency drive's common period ([`crate::params::Params::common_periods`];
+/// 1 for a quasi-periodic one).
+pub(crate) fn drive_periods(model: &CantileverModel) -> usize {
+    let t = std::f64::consts::TAU / model.omega();
+    ((model.period() / t).round() as usize).max(1)
+}
+
 /// Whether the stochastic step can integrate `law`: the piecewise-linear law exactly, a law
 /// whose force is a function of the state in each region (Hertz, DMT, electrostatic, and the
 /// hysteretic JKR and capillary laws, whose region the run carries) by the exponential Euler
@@ -179,23 +189,87 @@ pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
     })
 }
 
-/// [`admits`] for the law of `params`, under one harmonic drive.
+/// [`admits`] for the law of `params` (under any drive: a multifrequency drive's further
+/// components add their particular solutions, [`Component`]).
 ///
 /// # Errors
-/// As [`admits`]; [`SimError::OutOfRange`] naming `drive` for a multifrequency drive (the
-/// stochastic step propagates the one drive's particular solution; the lock-in's noise is that
-/// of one period).
+/// As [`admits`].
 pub fn admits_model(params: &crate::params::Params) -> Result<(), SimError> {
-    admits(&params.contact_law)?;
-    if params.is_multifrequency() {
-        return Err(SimError::out_of_range(
-            "drive",
-            "multifrequency",
-            "thermal noise is simulated under one harmonic drive: drop temperature or the \
-             further components",
-        ));
+    admits(&params.contact_law)
+}
+
+/// A further drive component's particular solution in one region of the linear part: its tip
+/// force F̃ cos(ωτ + θ) ([`crate::params::Params::component_force`], ω = p/q Ω) drives
+/// ż = A z + F̃ cos(ωτ + θ) e, e = (0, M⁻¹φ), whose periodic solution is
+/// z(τ) = Re[F̃ y e^{i(ωτ + θ)}] with (iωI − A) y = e: z = r cos(ωτ + θ) − j sin(ωτ + θ),
+/// (r, j) = F̃ (Re y, Im y) from the real system [[−A, −ωI], [ωI, −A]] (Re y, Im y) = (e, 0).
+/// The system is linear, so the particular solution of the whole drive is the primary's
+/// ([`Forced`]) plus every component's.
+#[derive(Debug, Clone)]
+struct Component {
+    /// ω and θ.
+    omega: f64,
+    phase: f64,
+    /// r and j (each `[2N]`).
+    re: DVector<f64>,
+    im: DVector<f64>,
+    /// Their tip deflections (tip·r, tip·j).
+    tip: (f64, f64),
+}
+
+impl Component {
+    /// The further components of `lin`'s drive in region `r` (none for a single-frequency
+    /// drive).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `drive_components.ratio` where ω is an undamped natural
+    /// frequency of the region (no periodic response).
+    fn of(lin: &CantileverModel, r: Region) -> Result<Vec<Component>, SimError> {
+        let p = lin.params();
+        let a = &lin.dynamics(r).a;
+        let (dim, n) = (a.nrows(), lin.modes());
+        p.components()
+            .map(|c| {
+                let omega = c.ratio() * p.omega;
+                let mut big = DMatrix::zeros(2 * dim, 2 * dim);
+                big.view_mut((0, 0), (dim, dim)).copy_from(&(-a));
+                big.view_mut((dim, dim), (dim, dim)).copy_from(&(-a));
+                for i in 0..dim {
+                    big[(i, dim + i)] = -omega;
+                    big[(dim + i, i)] = omega;
+                }
+                let mut rhs = DVector::zeros(2 * dim);
+                rhs.rows_mut(n, n).copy_from(lin.tip_mobility());
+                let y = big
+                    .lu()
+                    .solve(&rhs)
+                    .filter(|y| y.iter().all(|x| x.is_finite()));
+                let y = y.ok_or_else(|| {
+                    SimError::out_of_range(
+                        "drive_components.ratio",
+                        c.ratio(),
+                        "puts a component at an undamped natural frequency: no periodic \
+                         forced response (add damping)",
+                    )
+                })?;
+                let (re, im) = (y.rows(0, dim) * c.force, y.rows(dim, dim) * c.force);
+                let tip = (lin.tip().dot(&re.rows(0, n)), lin.tip().dot(&im.rows(0, n)));
+                Ok(Component {
+                    omega,
+                    phase: c.phase,
+                    re,
+                    im,
+                    tip,
+                })
+            })
+            .collect()
     }
-    Ok(())
+
+    /// cos and sin of ωτ + θ.
+    fn angle(&self, tau: f64) -> (f64, f64) {
+        let (s, c) = (self.omega * tau + self.phase).sin_cos();
+        (c, s)
+    }
 }
 
 /// How a thermally driven run of `law` is integrated (a document's `thermal.method`), and the
@@ -513,6 +587,9 @@ pub struct ThermalExact {
     /// z_F = −A⁻¹ (0, M⁻¹φ) and A⁻¹ z_F (each `[2N]`) and their tip deflections: the free
     /// lever's response to a unit tip force and to a unit rate of it (module docs).
     unit: [(DVector<f64>, f64); 2],
+    /// The further drive components' particular solutions in both regions (empty under one
+    /// harmonic drive).
+    components: [Vec<Component>; 2],
     /// The tip force over the piece under way, F₀ + F₁ (τ − τ₀): [F₀, F₁, τ₀] (0 under the
     /// linear law).
     frozen: Frozen,
@@ -581,12 +658,17 @@ impl ThermalExact {
         let far = Far::new(&lin, &diffusion[Region::Free.index()], force.kt)
             .filter(|_| !model.law().acts_outside());
         let unit = unit_response(&lin)?;
+        let components = [
+            Component::of(&lin, Region::Free)?,
+            Component::of(&lin, Region::Contact)?,
+        ];
         Ok(ThermalExact {
             det,
             exact,
             model: model.clone(),
             lin,
             unit,
+            components,
             frozen: [0.0; 3],
             force,
             diffusion,
@@ -608,12 +690,14 @@ impl ThermalExact {
         })
     }
 
-    /// Hold `samples` equally spaced points per period (the recording's or the lock-in's): a
-    /// free-flight step ends at the next of them at the latest, so that they are drawn points,
-    /// not bridges. Without it, or where the grid does not hold them (a grid of a multiple of
-    /// `samples` steps per period does), every grid point is held.
+    /// Hold `samples` equally spaced points per drive period 2π/Ω (the recording's or the
+    /// lock-in's): a free-flight step ends at the next of them at the latest, so that they are
+    /// drawn points, not bridges. Without it, or where the grid does not hold them (a grid of a
+    /// multiple of `samples` steps per period does; the grid spans the system's period,
+    /// [`drive_periods`] drive periods), every grid point is held.
     pub fn holding(mut self, samples: usize) -> ThermalExact {
         let m = self.det.grid.m;
+        let samples = samples * drive_periods(&self.model);
         self.hold = if samples > 0 && m.is_multiple_of(samples) {
             (m / samples) as i64
         } else {
@@ -627,7 +711,8 @@ impl ThermalExact {
         self.force
     }
 
-    /// The grid's sub-steps per drive period.
+    /// The grid's sub-steps per period of the system ([`CantileverModel::period`]: the drive
+    /// period, or a multifrequency drive's common period).
     pub fn steps_per_period(&self) -> usize {
         self.det.grid.m
     }
@@ -654,13 +739,33 @@ impl ThermalExact {
         root * zeta
     }
 
-    /// z_p(τ) of region `r` at (sin, cos) Ωτ = `sc`.
-    fn zp(&self, r: Region, (s, c): (f64, f64)) -> DVector<f64> {
+    /// z_p(τ) of region `r` at (sin, cos) Ωτ = `sc`: the primary drive's and the further
+    /// components'.
+    fn zp(&self, r: Region, tau: f64, (s, c): (f64, f64)) -> DVector<f64> {
         let f: &Forced = &self.det.forced[r.index()];
         let mut z = f.p0.clone();
         z.axpy(s, &f.ps, 1.0);
         z.axpy(c, &f.pc, 1.0);
+        self.add_components(r, tau, 1.0, &mut z);
         z
+    }
+
+    /// z += `sign` × the further components' particular solution in region `r` at `tau`.
+    fn add_components(&self, r: Region, tau: f64, sign: f64, z: &mut DVector<f64>) {
+        for k in &self.components[r.index()] {
+            let (c, s) = k.angle(tau);
+            z.axpy(sign * c, &k.re, 1.0);
+            z.axpy(-sign * s, &k.im, 1.0);
+        }
+    }
+
+    /// The further components' tip deflection in region `r` at `tau`.
+    fn components_tip(&self, r: Region, tau: f64) -> f64 {
+        let tip = |k: &Component| {
+            let (c, s) = k.angle(tau);
+            k.tip.0 * c - k.tip.1 * s
+        };
+        self.components[r.index()].iter().map(tip).sum()
     }
 
     /// The weights (F₀ + F₁ (τ − τ₀), F₁) of z_F and A⁻¹ z_F in the particular solution of the
@@ -673,7 +778,7 @@ impl ThermalExact {
     /// The particular solution of the piece under way at `tau`, (sin, cos) Ωτ = `sc`: z_p of
     /// region `r` and the response to its tip force.
     fn zs(&self, r: Region, tau: f64, sc: (f64, f64)) -> DVector<f64> {
-        let mut z = self.zp(r, sc);
+        let mut z = self.zp(r, tau, sc);
         for (w, (u, _)) in self.shift(tau).into_iter().zip(&self.unit) {
             if w != 0.0 {
                 z.axpy(w, u, 1.0);
@@ -697,6 +802,7 @@ impl ThermalExact {
         *out -= &f.p0;
         out.axpy(-s, &f.ps, 1.0);
         out.axpy(-c, &f.pc, 1.0);
+        self.add_components(r, tau, -1.0, out);
         for (w, (u, _)) in self.shift(tau).into_iter().zip(&self.unit) {
             if w != 0.0 {
                 out.axpy(-w, u, 1.0);
@@ -734,7 +840,7 @@ impl ThermalExact {
         let [w0, ws, wc] = self.det.forced[r.index()].wp;
         let [u, v] = &rung.mid.rows;
         let [c1, c2] = self.shift(tm);
-        let forced = c1 * self.unit[0].1 + c2 * self.unit[1].1;
+        let forced = c1 * self.unit[0].1 + c2 * self.unit[1].1 + self.components_tip(r, tm);
         let w = w0 + ws * scm.0 + wc * scm.1 + forced + u.dot(da) + v.dot(db);
         self.gap_of(r, self.model().v_t_at(scm, [w, 0.0, 0.0])[0])
     }
@@ -894,7 +1000,12 @@ impl ThermalExact {
         let (c0, r) = (self.model().params().alpha5 + w0, (ws + b).hypot(wc));
         let phase = wc.atan2(ws + b);
         let omega = self.model().omega();
-        let least = least_of_sine(c0, r, omega * t0 + phase, omega * t1 + phase);
+        // the further components' tip deflection, bounded by its amplitudes
+        let further: f64 = self.components[Region::Free.index()]
+            .iter()
+            .map(|k| k.tip.0.hypot(k.tip.1))
+            .sum();
+        let least = least_of_sine(c0, r, omega * t0 + phase, omega * t1 + phase) - further;
         let v = dz0.dot(&(&far.p_inv * dz0));
         least > far.sd * (v.sqrt() + FAR_KAPPA)
     }
