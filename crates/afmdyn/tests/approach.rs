@@ -354,8 +354,8 @@ fn traces_are_the_steady_cycles_of_the_curve() {
 /// given τ_L = 1 ms. In the repulsive regime the sample stiffens the amplitude, so σ_A falls
 /// below the free lever's. Points within 5 thermal standard deviations of the surface are
 /// said to be beyond the linear response. At a setpoint the operating points carry the noise of
-/// their orbits. Refused: without a probe, a time constant without a temperature, the impact
-/// law.
+/// their orbits; an impacting orbit's (the impact law) is below the free lever's. Refused:
+/// without a probe, a time constant without a temperature.
 #[test]
 fn a_temperature_gives_the_lock_ins_thermal_noise() {
     use afmdyn::analysis::progress::Progress;
@@ -468,17 +468,30 @@ fn a_temperature_gives_the_lock_ins_thermal_noise() {
         matches!(&e, SimError::OutOfRange { name, .. } if *name == "time_constant"),
         "{e}"
     );
-    // JKR's neck is carried (`analysis::orbit_noise`); the impact law's sticking is refused
+    // the impact law's jumps and sticking are carried (`analysis::orbit_noise`): the free end's
+    // σ_A is the free lever's, the impacting end's below it
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-jkr-polymer.toml");
     let jkr = std::fs::read_to_string(path).unwrap();
     let (head, tail) = jkr.split_at(jkr.find("[sample]").unwrap());
     let sample = "[sample]\nlaw = \"impact\"\nrestitution = 0.5\nz_c = 8e-9\n";
     let text = format!("{head}{sample}{}", &tail[tail.find("[drive]").unwrap()..]);
-    let e = refused(&super::common::resolved(&text, "impact"), hot(2, None));
-    assert!(
-        matches!(e, SimError::Unsupported { law: "impact", .. }),
-        "{e}"
+    let impact = super::common::resolved(&text, "impact");
+    let doc = run(&hot(6, None), &impact, &Progress::new()).unwrap().json;
+    let sigma = |i: usize| doc["approach"]["amplitude_noise"][i].as_f64().unwrap();
+    let p = impact.probe.as_ref().unwrap();
+    let (k, q, f0) = (
+        p.calibration.spring_constant,
+        p.calibration.quality_factor,
+        p.calibration.resonance_frequency,
     );
+    let tau_c = 2.0 * q / (std::f64::consts::TAU * f0);
+    let free = (kt / k * tau_c / (tau_c + tau_c / 4.0)).sqrt();
+    assert!(
+        (sigma(0) / free - 1.0).abs() < 0.01,
+        "{} vs {free}",
+        sigma(0)
+    );
+    assert!(sigma(5) < 0.9 * free, "{} vs {free}", sigma(5));
 }
 
 /// `approach --temperature` over an SLS sample (issue 79: its memory is the state's internal

@@ -188,9 +188,9 @@ def approach(
             period, switchings and the lock-in's filter included
             (``analysis::lock_in_noise``); under a multifrequency drive (bimodal) each
             component's lock-in's too, on the exact orbits of the common period (none on
-            time averages or invariant circles). Needs the probe's SI units; the impact law
-            is refused (its sticking holds the tip against the thermal force; SLS's dashpot
-            adds its own).
+            time averages or invariant circles). Needs the probe's SI units; every law (the
+            impact law's sticking holds the tip against the thermal force's part at it;
+            SLS's dashpot adds its own).
         time_constant: The lock-in's low-pass time constant τ_L (s; with ``temperature``), ≥
             0 and at most 1 000 s; ``None``: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time
             (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).
@@ -355,9 +355,9 @@ def bimodal(
             period, switchings and the lock-in's filter included
             (``analysis::lock_in_noise``); under a multifrequency drive (bimodal) each
             component's lock-in's too, on the exact orbits of the common period (none on
-            time averages or invariant circles). Needs the probe's SI units; the impact law
-            is refused (its sticking holds the tip against the thermal force; SLS's dashpot
-            adds its own).
+            time averages or invariant circles). Needs the probe's SI units; every law (the
+            impact law's sticking holds the tip against the thermal force's part at it;
+            SLS's dashpot adds its own).
         time_constant: The lock-in's low-pass time constant τ_L (s; with ``temperature``), ≥
             0 and at most 1 000 s; ``None``: τ_c/4, τ_c = 2Q/ω₀ the lever's amplitude time
             (the PI scan's default). Its noise-equivalent bandwidth is about 1/(4τ_L).
@@ -647,8 +647,8 @@ def fm(
             every point gains σ of the frequency shift and of the excitation that the loops
             read under the lever's thermal force, by linear response of the closed loop
             (``analysis::fm::noise``), and the document a ``"thermal"`` block. Needs the
-            probe's SI units; the impact law is refused (its sticking holds the tip against
-            the thermal force).
+            probe's SI units; every law (the impact law's sticking holds the tip against the
+            thermal force's part at it).
         to: Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0
             for the laws without attraction).
         tolerance: Tolerance of the loop conditions, ``|A₁/A − 1|`` and ``|φ₁ − φ_set|``
@@ -872,8 +872,9 @@ def peakforce(
             (``analysis::peakforce::tap_noise``; the per-cycle maxima's where the peak is
             sharp); a sweep gains them as the channels ``peak_force_noise`` and
             ``deformation_noise`` of every value (the block is the single-tap blocks'
-            tap's). Needs the probe's SI units; the impact law is refused (its sticking
-            holds the tip against the thermal force; SLS's dashpot adds its own).
+            tap's). Needs the probe's SI units; the impact law is refused (its peak force is
+            the sticking constraint's, white with the thermal force; SLS's dashpot adds its
+            own force).
         thermal_cycles: Modulation cycles of a thermally driven run of the tap (with
             ``temperature``; 100..=1000000): the ``"thermal"`` block gains ``simulated``,
             the per-cycle peak force's and deformation's σ (with standard errors) and

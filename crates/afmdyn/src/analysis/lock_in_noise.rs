@@ -91,8 +91,7 @@ impl LockInNoise {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `samples` (0), `kt` or `time_constant` (negative or not
-/// finite); [`SimError::Unsupported`] for the impact law (`crate::analysis::orbit_noise`); the
-/// integrator's and the flow's errors.
+/// finite); the integrator's and the flow's errors.
 pub fn lock_in_noise(
     model: &CantileverModel,
     z: &DVector<f64>,

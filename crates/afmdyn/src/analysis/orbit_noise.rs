@@ -31,16 +31,20 @@
 //! left at another distance than they formed) are followed by carrying the region from part to
 //! part: each part restarts the integrator in the region the last one ended in
 //! ([`crate::maps::flow::flow_in`]), the walk's start in the one the orbit's shooting starts it
-//! in ([`crate::system::HybridSystem::mode_at`]). The impact law is refused ([`admits`]): while
-//! it sticks, the constraint's reaction takes the thermal force's part at the tip, which the
-//! diffusion here does not remove.
+//! in ([`crate::system::HybridSystem::mode_at`]).
+//!
+//! The impact law's jumps are the flow's saltation matrices (Leine & Nijmeijer 2004, ch. 7). While
+//! it sticks, the constraint's reaction takes the thermal force's part at the tip: from
+//! M ä = f + φλ with φᵀä = 0 the velocity block of the diffusion is P D_vv Pᵀ,
+//! P = I − m_eff M⁻¹φ φᵀ (φᵀP = 0), and the motion is affine with the sticking field's Jacobian
+//! (the constraint held by its Baumgarte terms), so its parts are exact too. A beam pinned so
+//! at its tip fluctuates as equipartition conditioned on φᵀa fixed.
 //!
 //! This is the linear response of the measurement itself. It holds while σ stays small against
 //! the orbit's distance to grazing (a switching that the noise can remove or add is outside any
 //! linearisation), and only for a stable orbit (an unstable one has no stationary covariance).
 //! Units are the model's: τ (eq. 5), lengths in g₀, k_B T in the model's energy unit.
 
-use crate::contact::ContactLaw;
 use crate::contact::ForceEval;
 use crate::error::SimError;
 use crate::galerkin::Region;
@@ -65,40 +69,34 @@ const DOUBLINGS: usize = 64;
 /// beyond its validity ([`grazing`]).
 pub(crate) const NOISE_GRAZING: f64 = 5.0;
 
-/// How many of the orbits on `base` whose lowest points' tip–sample distances are
-/// `min_distances` (g₀) pass within [`NOISE_GRAZING`] thermal standard deviations of the
-/// surface at k_B T = `kt`.
+/// How many of the orbits on `base` of observables `orbits` pass within [`NOISE_GRAZING`]
+/// thermal standard deviations of the surface at k_B T = `kt`: their lowest point's tip–sample
+/// distance (g₀) within NOISE_GRAZING √(k_BT c_s) of it. An impacting orbit of the impact law
+/// always reaches the surface; its own grazing is an impact at vanishing speed (Nordmark 1991),
+/// so it counts where its impacts' root-mean-square speed v, from their kinetic-energy loss
+/// ½ m_eff (1 − r²) v² each, is below NOISE_GRAZING thermal speeds √(k_BT/m_eff) (always for
+/// r = 1, which loses none).
 ///
 /// # Errors
 /// The model's.
-pub(crate) fn grazing(
+pub(crate) fn grazing<'o>(
     base: &crate::Params,
     kt: f64,
-    min_distances: impl Iterator<Item = f64>,
+    orbits: impl Iterator<Item = &'o crate::analysis::observables::Observables>,
 ) -> Result<usize, SimError> {
     let model = CantileverModel::new(base)?;
     let sigma = (kt * crate::analysis::peakforce::static_compliance(&model)).sqrt();
     let offset = base.contact_law.distance_offset();
-    Ok(min_distances
-        .filter(|d| (d - offset).abs() < NOISE_GRAZING * sigma)
-        .count())
-}
-
-/// Whether the linear response covers `law` (module docs): every law but the impact law.
-///
-/// # Errors
-/// [`SimError::Unsupported`] naming the impact law, whose sticking the walk's diffusion does not
-/// constrain (module docs).
-pub(crate) fn admits(law: &ContactLaw) -> Result<(), SimError> {
-    if law.restitution().is_none() {
-        return Ok(());
-    }
-    Err(SimError::Unsupported {
-        integrator: "linear response",
-        law: law.name(),
-        hint: "the thermal noise's linear response follows every law but the impact law, whose \
-               sticking holds the tip against the thermal force: drop temperature for it",
-    })
+    let (restitution, m_eff) = (base.contact_law.restitution(), model.effective_mass());
+    let near = |o: &crate::analysis::observables::Observables| match restitution {
+        Some(r) if o.impacts_per_period > 0.0 => {
+            let v2 = 2.0 * o.impact_loss / (o.impacts_per_period * m_eff * (1.0 - r * r));
+            // NaN (r = 1: no loss to read the speed from) counts
+            v2.is_nan() || v2 < NOISE_GRAZING * NOISE_GRAZING * kt / m_eff
+        }
+        _ => (o.min_distance - offset).abs() < NOISE_GRAZING * sigma,
+    };
+    Ok(orbits.filter(|o| near(o)).count())
 }
 
 /// The chain y ↦ F y + ξ, ξ ~ N(0, W), from the period's start to the walk's time (module docs).
@@ -148,8 +146,9 @@ pub(crate) struct Walk<'a> {
     model: &'a CantileverModel,
     /// The lever without the sample (its A_s and the diffusion's damping).
     linear: CantileverModel,
-    /// Whether the law is SLS: affine in each region with its internal state (module docs).
-    zener: bool,
+    /// Per region, whether the motion is affine with the model's own matrix (its Jacobian):
+    /// SLS in both regions (with its internal state), the impact law's sticking (module docs).
+    own_matrix: [bool; 2],
     integ: Box<dyn Integrator>,
     /// D per region.
     d: [DMatrix<f64>; 2],
@@ -176,9 +175,7 @@ impl<'a> Walk<'a> {
     /// followed by `observers` states.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `kt` (negative or not finite),
-    /// [`SimError::Unsupported`] for the impact law ([`admits`]);
-    /// the integrator's.
+    /// [`SimError::OutOfRange`] naming `kt` (negative or not finite); the integrator's.
     pub(crate) fn new(
         model: &'a CantileverModel,
         z: &DVector<f64>,
@@ -193,16 +190,19 @@ impl<'a> Walk<'a> {
                 "must be a finite number ≥ 0",
             ));
         }
-        admits(&model.params().contact_law)?;
         let linear = linear_part(model)?;
         // the SLS dashpot's own force, white with 2 k_BT α6, on its extension u (module docs)
         let zener = model.params().contact_law.internal_states() > 0;
+        let sticks = model.params().contact_law.restitution().is_some();
         let (dim, modes) = (z.len(), model.modes());
         let d = [Region::Free, Region::Contact].map(|r| {
             let mut d = DMatrix::zeros(dim, dim);
             (d.view_mut((0, 0), (2 * modes, 2 * modes))).copy_from(&diffusion(&linear, r, kt));
             if zener {
                 d[(2 * modes, 2 * modes)] = 2.0 * kt / model.params().alpha6;
+            }
+            if sticks && r == Region::Contact {
+                constrain(model, &mut d);
             }
             d
         });
@@ -211,7 +211,7 @@ impl<'a> Walk<'a> {
         Ok(Walk {
             integ: build(model, options, 0.0, z)?,
             linear,
-            zener,
+            own_matrix: [zener, zener || sticks],
             d,
             region,
             force,
@@ -273,7 +273,7 @@ impl<'a> Walk<'a> {
     /// Whether the motion in `r` is linear (module docs).
     fn linear_in(&self, r: Region) -> bool {
         let law = self.model.law();
-        law.is_affine() || self.zener || (r == Region::Free && !law.acts_outside())
+        law.is_affine() || self.own_matrix[r.index()] || (r == Region::Free && !law.acts_outside())
     }
 
     /// Take the part to `t1` of flow `fl`, ending in region `to` under the tip force `force`
@@ -290,9 +290,9 @@ impl<'a> Walk<'a> {
         if exact {
             let i = from.index();
             if !matches!(&self.exact[i], Some((l, _)) if *l == h) {
-                // SLS's region matrix holds its internal state's rows (the model's Jacobian,
-                // constant in each region)
-                let (_, q) = if self.zener {
+                // SLS's region matrix holds its internal state's rows, the sticking one the
+                // constraint's (the model's Jacobian, constant in each region)
+                let (_, q) = if self.own_matrix[i] {
                     let mut a = DMatrix::zeros(dim, dim);
                     (self.model).jacobian_into(from, self.tau, self.state.as_slice(), &mut a);
                     van_loan(&a, &self.d[i], h)
@@ -309,6 +309,24 @@ impl<'a> Walk<'a> {
         (self.state, self.tau, self.region) = (fl.state, t1, to);
         (self.force, self.force_u) = (force, force_u);
     }
+}
+
+/// The diffusion `d` (shape `[dim, dim]`) of a tip held on the surface (the impact law's
+/// sticking): the constraint's reaction takes the thermal force's part at the tip, so the
+/// velocity block becomes P D_vv Pᵀ, P = I − m_eff M⁻¹φ φᵀ (φᵀP = 0: no tip acceleration),
+/// from M ä = f + φλ with φᵀä = 0.
+fn constrain(model: &CantileverModel, d: &mut DMatrix<f64>) {
+    let n = model.modes();
+    let mut p = DMatrix::identity(n, n);
+    p.ger(
+        -model.effective_mass(),
+        model.tip_mobility(),
+        model.tip(),
+        1.0,
+    );
+    let vv = &p * d.view((n, n), (n, n)) * p.transpose();
+    d.view_mut((n, n), (n, n))
+        .copy_from(&(0.5 * (&vv + vv.transpose())));
 }
 
 /// The law's tip force at (τ, `z`) in region `r` of `model` and its rate ∂F_c/∂u on SLS's

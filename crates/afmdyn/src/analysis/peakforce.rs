@@ -35,7 +35,7 @@
 
 mod filter;
 mod fit;
-mod noise;
+pub(crate) mod noise;
 #[cfg(test)]
 pub(crate) use noise::batch_variance;
 mod setpoint;

@@ -47,8 +47,8 @@ request! {
         /// a value in °C?); `None` (the default): no noise. With one every point gains σ of the
         /// frequency shift and of the excitation that the loops read under the lever's thermal
         /// force, by linear response of the closed loop ([`crate::analysis::fm::noise`]), and the
-        /// document a `"thermal"` block. Needs the probe's SI units; the impact law is refused
-        /// (its sticking holds the tip against the thermal force).
+        /// document a `"thermal"` block. Needs the probe's SI units; every law (the impact law's
+        /// sticking holds the tip against the thermal force's part at it).
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
         /// The loops' equivalent noise bandwidth B (Hz; with `temperature`), > 0 and at most

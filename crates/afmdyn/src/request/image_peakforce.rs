@@ -73,7 +73,7 @@ pub(crate) fn peakforce_cost(
     if let Some(t) = req.temperature {
         thermal_force(t, 0, Some(&background))?;
         for (_, q) in &models {
-            crate::analysis::orbit_noise::admits(&q.contact_law)?;
+            crate::analysis::peakforce::noise::admits(&q.contact_law)?;
             noise += super::peakforce::noise_work(q);
         }
     }

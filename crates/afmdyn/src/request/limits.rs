@@ -190,16 +190,13 @@ pub(crate) fn thermal_force(
 }
 
 /// k_B T at `t` in the model's energy unit of `model`'s probe, for a linear-response noise
-/// estimate of its law ([`thermal_force`]'s checks, then the linear response's,
-/// `crate::analysis::orbit_noise::admits`: the impact law is refused; the orbit's chain holds
-/// every drive component, `crate::analysis::lock_in_noise`).
+/// estimate ([`thermal_force`]'s checks; the orbit's chain holds every law and every drive
+/// component, `crate::analysis::orbit_noise`, `crate::analysis::lock_in_noise`).
 ///
 /// # Errors
-/// As [`thermal_force`]; [`crate::SimError::Unsupported`] for the impact law.
+/// As [`thermal_force`].
 pub(crate) fn thermal_kt(t: f64, model: &super::Resolved) -> Result<f64, crate::SimError> {
-    let kt = thermal_force(t, 0, model.probe.as_ref())?.kt;
-    crate::analysis::orbit_noise::admits(&model.params.contact_law)?;
-    Ok(kt)
+    Ok(thermal_force(t, 0, model.probe.as_ref())?.kt)
 }
 
 /// Refuse the options of `needs` (name, value) that only a temperature `t` gives a meaning

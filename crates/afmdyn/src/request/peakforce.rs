@@ -81,7 +81,8 @@ request! {
         /// per-cycle maxima's where the peak is sharp); a sweep gains them as the channels
         /// `peak_force_noise` and `deformation_noise` of every value (the block is the
         /// single-tap blocks' tap's). Needs the probe's SI units; the impact law is refused (its
-        /// sticking holds the tip against the thermal force; SLS's dashpot adds its own).
+        /// peak force is the sticking constraint's, white with the thermal force; SLS's dashpot
+        /// adds its own force).
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
         /// Modulation cycles of a thermally driven run of the tap (with `temperature`;
@@ -180,6 +181,9 @@ impl PeakForceRequest {
         let cycles = self.thermal_cycles.map(|n| n as f64);
         let kt =
             super::limits::optional_kt(self.temperature, &[("thermal_cycles", cycles)], model)?;
+        if kt.is_some() {
+            crate::analysis::peakforce::noise::admits(&model.params.contact_law)?;
+        }
         if let Some(n) = self.thermal_cycles {
             let why = "must be at least 100 modulation cycles";
             crate::error::within("thermal_cycles", n, MIN_THERMAL_CYCLES.., why)?;

@@ -313,8 +313,8 @@ request! {
         /// lock-in's filter included ([`crate::analysis::lock_in_noise`]); under a
         /// multifrequency drive (bimodal) each component's lock-in's too, on the exact orbits of
         /// the common period (none on time averages or invariant circles). Needs the probe's SI
-        /// units; the impact law is refused (its sticking holds the tip against the thermal
-        /// force; SLS's dashpot adds its own).
+        /// units; every law (the impact law's sticking holds the tip against the thermal force's
+        /// part at it; SLS's dashpot adds its own).
         #[serde(skip_serializing_if = "Option::is_none")]
         pub temperature: Option<f64>,
         /// The lock-in's low-pass time constant τ_L (s; with `temperature`), ≥ 0 and at most
@@ -358,8 +358,7 @@ impl ApproachRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `temperature` (out of range, without a probe) or
-    /// `time_constant` (out of range, or without a temperature);
-    /// [`SimError::Unsupported`] for the impact law.
+    /// `time_constant` (out of range, or without a temperature).
     fn thermal(&self, model: &Resolved) -> Result<Option<ThermalLockIn>, SimError> {
         let needs = [("time_constant", self.time_constant)];
         let Some(kt) = super::limits::optional_kt(self.temperature, &needs, model)? else {

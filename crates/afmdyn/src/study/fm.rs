@@ -273,7 +273,7 @@ fn warnings(
     }
     if let (Some(t), Some((_, kt))) = (request.temperature, noise) {
         warnings.extend(crate::request::limits::temperature_warnings(t));
-        let lowest = curve.points.iter().map(|q| q.observables.min_distance);
+        let lowest = curve.points.iter().map(|q| &q.observables);
         if let Ok(near @ 1..) = grazing(&model.params, kt, lowest) {
             warnings.push(warning!(
                 "fm.noise-grazing",

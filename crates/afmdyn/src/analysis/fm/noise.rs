@@ -80,8 +80,7 @@ pub fn loop_gain(bandwidth: f64, rate: f64) -> f64 {
 /// `kt` (k_B T in the model's energy unit), the loop's gains `gains`.
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming `kt`; [`SimError::Unsupported`] for the impact law; the
-/// model's, the integrator's and the flow's errors.
+/// [`SimError::OutOfRange`] naming `kt`; the model's, the integrator's and the flow's errors.
 pub fn fm_noise(
     base: &Params,
     point: &FmPoint,

@@ -125,6 +125,26 @@ impl Extremum {
     }
 }
 
+/// Whether the tap's noise covers `law`: every law but the impact law, whose peak force while
+/// it sticks is the constraint's force λ, which takes the thermal force's part at the tip
+/// itself (M ä = f + ξ + φλ, φᵀä = 0): white, its peak has no finite σ but through a
+/// detector's bandwidth, which the tap's linear response does not model.
+///
+/// # Errors
+/// [`SimError::Unsupported`] naming the impact law.
+pub(crate) fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
+    if law.restitution().is_none() {
+        return Ok(());
+    }
+    Err(SimError::Unsupported {
+        integrator: "linear response",
+        law: law.name(),
+        hint: "a PeakForce tap's thermal noise follows every law but the impact law, whose peak \
+               force is the sticking constraint's, white with the thermal force: drop \
+               temperature for it",
+    })
+}
+
 /// The largest mean shift of a channel's per-cycle maximum by the noise's slope,
 /// E\[ṅ²\]/(2|F''|), against its σ, for the linear response to be the maximum's (module docs):
 /// measured up to 0.35 within 5 % of the simulated maxima's σ, at 42 twice it.
@@ -144,6 +164,7 @@ pub fn tap_noise(
     kt: f64,
     integrator: IntegratorOptions,
 ) -> Result<TapNoise, SimError> {
+    admits(&model.params().contact_law)?;
     let end = periods.max(1) as f64 * model.period();
     let h = ETA / super::first_natural_frequency(model);
     let mut walk = Walk::new(model, z, kt, 0, integrator)?;

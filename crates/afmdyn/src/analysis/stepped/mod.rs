@@ -677,7 +677,7 @@ fn curve_noise(
         return Ok(None);
     };
     let orbits = (sweeps.iter().flat_map(|s| s.iter())).filter(|p| p.noise_orbit());
-    let near = grazing(&spec.base, n.kt, orbits.map(|p| p.observables.min_distance))?;
+    let near = grazing(&spec.base, n.kt, orbits.map(|p| &p.observables))?;
     if near > 0 {
         warnings.push(warning!(
             "thermal.noise-grazing",
