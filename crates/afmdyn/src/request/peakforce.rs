@@ -181,9 +181,9 @@ impl PeakForceRequest {
         let cycles = self.thermal_cycles.map(|n| n as f64);
         let kt =
             super::limits::optional_kt(self.temperature, &[("thermal_cycles", cycles)], model)?;
-        if kt.is_some() {
-            crate::analysis::peakforce::noise::admits(&model.params.contact_law)?;
-        }
+        let law = &model.params.contact_law;
+        kt.map(|_| crate::analysis::peakforce::noise::admits(law))
+            .transpose()?;
         if let Some(n) = self.thermal_cycles {
             let why = "must be at least 100 modulation cycles";
             crate::error::within("thermal_cycles", n, MIN_THERMAL_CYCLES.., why)?;

@@ -219,10 +219,7 @@ impl SimulateRequest {
                 "thermal noise is advanced by the exact stochastic step: auto or exact",
             ));
         }
-        // the grid spans the system's period: a multifrequency drive's common period holds
-        // its drive periods' samples
-        let held = self.samples_per_period * crate::integrate::exact::noise::drive_periods(model);
-        opts.steps_per_period = holding_samples(opts.steps_per_period, held);
+        opts.steps_per_period = holding_samples(opts.steps_per_period, self.samples_per_period);
         let mut it = ThermalExact::new(model, &opts, force)?.holding(self.samples_per_period);
         it.reset(0.0, z0)?;
         Ok(Box::new(it))

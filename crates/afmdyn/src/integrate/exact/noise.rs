@@ -190,7 +190,7 @@ pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
 }
 
 /// [`admits`] for the law of `params` (under any drive: a multifrequency drive's further
-/// components add their particular solutions, [`Component`]).
+/// components add their particular solutions, module docs).
 ///
 /// # Errors
 /// As [`admits`].
@@ -629,7 +629,8 @@ type Piece = (f64, usize, Option<(i64, u64)>, Option<Arc<[Rung]>>);
 
 impl ThermalExact {
     /// Build for `model` with `force`, the grid of the exact propagator for `opts` (a multiple
-    /// of its steps per period, refined to resolve the fastest mode).
+    /// of its steps per drive period 2π/Ω over each of the system's `drive_periods`, refined
+    /// to resolve the fastest mode).
     ///
     /// # Errors
     /// [`SimError::Unsupported`] naming the law for a law that is not piecewise linear (the
@@ -640,8 +641,9 @@ impl ThermalExact {
         force: ThermalForce,
     ) -> Result<ThermalExact, SimError> {
         admits_model(model.params())?;
+        // steps per drive period 2π/Ω; the grid spans the system's period
         let exact = ExactOptions {
-            min_steps_per_period: opts.steps_per_period,
+            min_steps_per_period: opts.steps_per_period * drive_periods(model),
             cache: Some(opts.cache.clone()),
             ..ExactOptions::default()
         };
@@ -694,7 +696,7 @@ impl ThermalExact {
     /// lock-in's): a free-flight step ends at the next of them at the latest, so that they are
     /// drawn points, not bridges. Without it, or where the grid does not hold them (a grid of a
     /// multiple of `samples` steps per period does; the grid spans the system's period,
-    /// [`drive_periods`] drive periods), every grid point is held.
+    /// `drive_periods` drive periods), every grid point is held.
     pub fn holding(mut self, samples: usize) -> ThermalExact {
         let m = self.det.grid.m;
         let samples = samples * drive_periods(&self.model);
