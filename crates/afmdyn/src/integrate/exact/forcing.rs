@@ -104,6 +104,44 @@ pub(super) fn forcing_key(model: &CantileverModel, spectral_key: &[u64], h: f64)
     key
 }
 
+/// (ps, pc) and the LU of [[A, ωI], [−ωI, A]]: [`harmonic_response`]'s.
+pub(super) type Harmonic = (DVector<f64>, DVector<f64>, LU<f64, Dyn, Dyn>);
+
+/// The periodic response z = ps sin ωτ + pc cos ωτ of ż = A z + b_s sin ωτ + b_c cos ωτ
+/// (`b` = (b_s, b_c), each `[dim]`): [[A, ωI], [−ωI, A]] (ps, pc) = −(b_s, b_c), with the LU of
+/// that matrix (4N × 4N). `None` at an undamped natural frequency ω, or within round-off of
+/// one (an amplification beyond 10¹³).
+pub(super) fn harmonic_response(
+    a: &DMatrix<f64>,
+    omega: f64,
+    (b_sin, b_cos): (&DVector<f64>, &DVector<f64>),
+) -> Option<Harmonic> {
+    let dim = a.nrows();
+    let mut big = DMatrix::zeros(2 * dim, 2 * dim);
+    big.view_mut((0, 0), (dim, dim)).copy_from(a);
+    big.view_mut((dim, dim), (dim, dim)).copy_from(a);
+    for i in 0..dim {
+        big[(i, dim + i)] = omega;
+        big[(dim + i, i)] = -omega;
+    }
+    let mut rhs = DVector::zeros(2 * dim);
+    rhs.rows_mut(0, dim).copy_from(&(-b_sin));
+    rhs.rows_mut(dim, dim).copy_from(&(-b_cos));
+    let big_norm = big.norm();
+    let lu = big.lu();
+    let sol = lu.solve(&rhs)?;
+    // numerically singular (ω within round-off of an undamped resonance)
+    let amplification = sol.norm() * big_norm;
+    if rhs.norm() > 0.0 && (amplification.is_nan() || amplification > 1e13 * rhs.norm()) {
+        return None;
+    }
+    let (ps, pc) = (
+        sol.rows(0, dim).into_owned(),
+        sol.rows(dim, dim).into_owned(),
+    );
+    Some((ps, pc, lu))
+}
+
 /// Particular solution of one region and its grid values: A p0 = −b_const and
 /// [[A, ΩI], [−ΩI, A]] (ps, pc) = −(b_sin, b_cos) (eq. 10 with harmonic forcing).
 pub(super) fn forced(
@@ -121,16 +159,6 @@ pub(super) fn forced(
         .a_lu
         .solve(&(-&d.b_const))
         .ok_or_else(|| SimError::out_of_range("state matrix", "singular", "K must be SPD"))?;
-    let mut big = DMatrix::zeros(2 * dim, 2 * dim);
-    big.view_mut((0, 0), (dim, dim)).copy_from(&d.a);
-    big.view_mut((dim, dim), (dim, dim)).copy_from(&d.a);
-    for i in 0..dim {
-        big[(i, dim + i)] = omega;
-        big[(dim + i, i)] = -omega;
-    }
-    let mut rhs = DVector::zeros(2 * dim);
-    rhs.rows_mut(0, dim).copy_from(&(-&d.b_sin));
-    rhs.rows_mut(dim, dim).copy_from(&(-&d.b_cos));
     let resonance = || {
         SimError::out_of_range(
             "omega",
@@ -138,16 +166,8 @@ pub(super) fn forced(
             "is an undamped natural frequency: no periodic forced response (add damping)",
         )
     };
-    let big_norm = big.norm();
-    let harmonic_lu = big.lu();
-    let sol = harmonic_lu.solve(&rhs).ok_or_else(resonance)?;
-    // numerically singular (Ω within round-off of an undamped resonance)
-    let amplification = sol.norm() * big_norm;
-    if rhs.norm() > 0.0 && (amplification.is_nan() || amplification > 1e13 * rhs.norm()) {
-        return Err(resonance());
-    }
-    let ps = sol.rows(0, dim).into_owned();
-    let pc = sol.rows(dim, dim).into_owned();
+    let (ps, pc, harmonic_lu) =
+        harmonic_response(&d.a, omega, (&d.b_sin, &d.b_cos)).ok_or_else(resonance)?;
     let mut zp_grid = DMatrix::zeros(dim, trig.len());
     let (a, b, d) = (p0.as_slice(), ps.as_slice(), pc.as_slice());
     for (col, &(s, c)) in zp_grid.as_mut_slice().chunks_exact_mut(dim).zip(trig) {

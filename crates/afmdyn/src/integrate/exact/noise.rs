@@ -14,8 +14,8 @@
 //! # The exact step
 //! With δz = z − z_p(τ) (z_p the region's periodic particular solution: the deterministic
 //! propagator's of the primary drive, [`super::ExactPropagator`], plus that of each further
-//! component of a multifrequency drive, a tip force F̃ cos(ωτ + θ) whose response is
-//! Re[F̃ (iωI − A_s)⁻¹ (0, M⁻¹φ) e^{i(ωτ + θ)}]) the step of length ℓ is
+//! component of a multifrequency drive, a tip force F̃ cos(ωτ + θ) answered the same way) the
+//! step of length ℓ is
 //! δz(τ + ℓ) = Φ(ℓ) δz(τ) + w, w ~ N(0, Q(ℓ)), Φ(ℓ) = e^{A_s ℓ}, Q(ℓ) = ∫₀^ℓ e^{A_s u} GGᵀ
 //! e^{A_sᵀ u} du, exact at any ℓ (the free lever's thermal motion is exact whatever the grid).
 //! Φ and Q come from one block exponential, exp([[−A, GGᵀ], [0, Aᵀ]] ℓ) = [[·, F₁₂], [0, F₂₂]]:
@@ -89,7 +89,7 @@
 //! points already drawn, by a second stream of the seed, so that the path at the grid points
 //! does not depend on the samples asked for.
 
-use super::forcing::Forced;
+use super::forcing::{harmonic_response, Forced};
 use super::tip::tip_v_t;
 use super::{ExactOptions, ExactPropagator};
 use crate::error::SimError;
@@ -199,21 +199,18 @@ pub fn admits_model(params: &crate::params::Params) -> Result<(), SimError> {
 }
 
 /// A further drive component's particular solution in one region of the linear part: its tip
-/// force F̃ cos(ωτ + θ) ([`crate::params::Params::component_force`], ω = p/q Ω) drives
-/// ż = A z + F̃ cos(ωτ + θ) e, e = (0, M⁻¹φ), whose periodic solution is
-/// z(τ) = Re[F̃ y e^{i(ωτ + θ)}] with (iωI − A) y = e: z = r cos(ωτ + θ) − j sin(ωτ + θ),
-/// (r, j) = F̃ (Re y, Im y) from the real system [[−A, −ωI], [ωI, −A]] (Re y, Im y) = (e, 0).
-/// The system is linear, so the particular solution of the whole drive is the primary's
-/// ([`Forced`]) plus every component's.
+/// force F̃ cos(ωτ + θ) ([`crate::params::Params::component_force`], ω = p/q Ω), the forcing
+/// e F̃ (cos θ cos ωτ − sin θ sin ωτ), e = (0, M⁻¹φ), has the periodic response
+/// z = ps sin ωτ + pc cos ωτ ([`harmonic_response`], as the primary drive's). The system is
+/// linear, so the particular solution of the whole drive is the primary's ([`Forced`]) plus
+/// every component's.
 #[derive(Debug, Clone)]
 struct Component {
-    /// ω and θ.
     omega: f64,
-    phase: f64,
-    /// r and j (each `[2N]`).
-    re: DVector<f64>,
-    im: DVector<f64>,
-    /// Their tip deflections (tip·r, tip·j).
+    /// ps and pc (each `[2N]`).
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    /// Their tip deflections (tip·ps, tip·pc).
     tip: (f64, f64),
 }
 
@@ -225,50 +222,32 @@ impl Component {
     /// [`SimError::OutOfRange`] naming `drive_components.ratio` where ω is an undamped natural
     /// frequency of the region (no periodic response).
     fn of(lin: &CantileverModel, r: Region) -> Result<Vec<Component>, SimError> {
-        let p = lin.params();
-        let a = &lin.dynamics(r).a;
-        let (dim, n) = (a.nrows(), lin.modes());
+        let (p, n) = (lin.params(), lin.modes());
+        let mut e = DVector::zeros(2 * n);
+        e.rows_mut(n, n).copy_from(lin.tip_mobility());
         p.components()
             .map(|c| {
                 let omega = c.ratio() * p.omega;
-                let mut big = DMatrix::zeros(2 * dim, 2 * dim);
-                big.view_mut((0, 0), (dim, dim)).copy_from(&(-a));
-                big.view_mut((dim, dim), (dim, dim)).copy_from(&(-a));
-                for i in 0..dim {
-                    big[(i, dim + i)] = -omega;
-                    big[(dim + i, i)] = omega;
-                }
-                let mut rhs = DVector::zeros(2 * dim);
-                rhs.rows_mut(n, n).copy_from(lin.tip_mobility());
-                let y = big
-                    .lu()
-                    .solve(&rhs)
-                    .filter(|y| y.iter().all(|x| x.is_finite()));
-                let y = y.ok_or_else(|| {
-                    SimError::out_of_range(
-                        "drive_components.ratio",
-                        c.ratio(),
-                        "puts a component at an undamped natural frequency: no periodic \
-                         forced response (add damping)",
-                    )
-                })?;
-                let (re, im) = (y.rows(0, dim) * c.force, y.rows(dim, dim) * c.force);
-                let tip = (lin.tip().dot(&re.rows(0, n)), lin.tip().dot(&im.rows(0, n)));
-                Ok(Component {
-                    omega,
-                    phase: c.phase,
-                    re,
-                    im,
-                    tip,
-                })
+                let (s, co) = c.phase.sin_cos();
+                let b = (&e * (-c.force * s), &e * (c.force * co));
+                let (ps, pc, _) = harmonic_response(&lin.dynamics(r).a, omega, (&b.0, &b.1))
+                    .ok_or_else(|| {
+                        SimError::out_of_range(
+                            "drive_components.ratio",
+                            c.ratio(),
+                            "puts a component at an undamped natural frequency: no periodic \
+                             forced response (add damping)",
+                        )
+                    })?;
+                let tip = (lin.tip().dot(&ps.rows(0, n)), lin.tip().dot(&pc.rows(0, n)));
+                Ok(Component { omega, ps, pc, tip })
             })
             .collect()
     }
 
-    /// cos and sin of ωτ + θ.
+    /// (sin, cos) ωτ.
     fn angle(&self, tau: f64) -> (f64, f64) {
-        let (s, c) = (self.omega * tau + self.phase).sin_cos();
-        (c, s)
+        (self.omega * tau).sin_cos()
     }
 }
 
@@ -755,17 +734,17 @@ impl ThermalExact {
     /// z += `sign` × the further components' particular solution in region `r` at `tau`.
     fn add_components(&self, r: Region, tau: f64, sign: f64, z: &mut DVector<f64>) {
         for k in &self.components[r.index()] {
-            let (c, s) = k.angle(tau);
-            z.axpy(sign * c, &k.re, 1.0);
-            z.axpy(-sign * s, &k.im, 1.0);
+            let (s, c) = k.angle(tau);
+            z.axpy(sign * s, &k.ps, 1.0);
+            z.axpy(sign * c, &k.pc, 1.0);
         }
     }
 
     /// The further components' tip deflection in region `r` at `tau`.
     fn components_tip(&self, r: Region, tau: f64) -> f64 {
         let tip = |k: &Component| {
-            let (c, s) = k.angle(tau);
-            k.tip.0 * c - k.tip.1 * s
+            let (s, c) = k.angle(tau);
+            k.tip.0 * s + k.tip.1 * c
         };
         self.components[r.index()].iter().map(tip).sum()
     }

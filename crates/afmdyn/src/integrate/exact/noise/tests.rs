@@ -799,8 +799,8 @@ fn a_lever_pressed_into_a_hertz_sample_fluctuates_with_the_contact_stiffness() {
 /// incommensurate-looking ratio 627/100 (a common period of 100 drive periods), the state after
 /// 4 periods from rest. The exact step follows the primary's and each component's particular
 /// solution: far from the sample the state is the deterministic one within 10⁻⁹ of it (the
-/// integrators' tolerance; measured 7·10⁻¹¹); tapping, within 10⁻⁴ (measured 3.4·10⁻⁵ and
-/// 7.4·10⁻⁵; 3.7·10⁻⁵ without the components: the switchings located to h/4096 on the bridge),
+/// integrators' tolerance; measured 7·10⁻¹¹); tapping, within 10⁻⁴ (measured 5.9·10⁻⁵ and
+/// 1.7·10⁻⁵; 3.7·10⁻⁵ without the components: the switchings located to h/4096 on the bridge),
 /// while the components move it by more than 10⁻² (the run without them).
 #[test]
 fn a_multifrequency_drive_is_the_deterministic_run_as_the_temperature_vanishes() {
