@@ -177,13 +177,13 @@ fn bad_input_exits_2_naming_the_field() {
             "{err}"
         );
     }
-    // an SLS stripe: its dashpot's extension, a state of its own, has no stochastic step,
-    // refused naming it before any curve runs
-    let sls = dir.path().join("sls.toml");
+    // an impact stripe: its tip jumps and sticks, which has no stochastic step, refused naming
+    // it before any curve runs
+    let impact = dir.path().join("impact.toml");
     std::fs::write(
-        &sls,
+        &impact,
         "size = [1e-6, 0]\n[[domain]]\nname = \"j\"\nx = [3e-7, 5e-7]\n[domain.sample]\n\
-         law = \"sls\"\nstiffness = 2.0\nmaxwell_stiffness = 3.0\nrelaxation_time = 1e-6\n",
+         law = \"impact\"\nrestitution = 0.5\n",
     )
     .unwrap();
     let out = afmdyn(&[
@@ -191,7 +191,7 @@ fn bad_input_exits_2_naming_the_field() {
         "--probe",
         "examples/probe-point-mass-dmt.toml",
         "--sample",
-        sls.to_str().unwrap(),
+        impact.to_str().unwrap(),
         "--setpoint",
         "0.7",
         "--feedback",
@@ -204,7 +204,7 @@ fn bad_input_exits_2_naming_the_field() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("sls") && err.trim().lines().count() == 1,
+        err.contains("impact") && err.trim().lines().count() == 1,
         "{err}"
     );
     let out = afmdyn(&[

@@ -48,7 +48,7 @@
 use crate::contact::ForceEval;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::noise::{diffusion, linear_part, rate_of, van_loan};
+use crate::integrate::exact::noise::{linear_part, rate_of, state_diffusion, van_loan};
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::flow::{flow_in, FlowMap};
 use crate::model::CantileverModel;
@@ -191,16 +191,12 @@ impl<'a> Walk<'a> {
             ));
         }
         let linear = linear_part(model)?;
-        // the SLS dashpot's own force, white with 2 k_BT α6, on its extension u (module docs)
+        // SLS (the dashpot's own force on u, `state_diffusion`) and sticking: exact parts over
+        // the model's own matrix (module docs)
         let zener = model.params().contact_law.internal_states() > 0;
         let sticks = model.params().contact_law.restitution().is_some();
-        let (dim, modes) = (z.len(), model.modes());
         let d = [Region::Free, Region::Contact].map(|r| {
-            let mut d = DMatrix::zeros(dim, dim);
-            (d.view_mut((0, 0), (2 * modes, 2 * modes))).copy_from(&diffusion(&linear, r, kt));
-            if zener {
-                d[(2 * modes, 2 * modes)] = 2.0 * kt / model.params().alpha6;
-            }
+            let mut d = state_diffusion(model, &linear, r, kt);
             if sticks && r == Region::Contact {
                 constrain(model, &mut d);
             }

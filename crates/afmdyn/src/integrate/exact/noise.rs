@@ -1,6 +1,6 @@
-//! The thermally driven lever: the exact stochastic step of the piecewise-linear model
-//! ([`ThermalExact`]), with the switchings the noise makes between two steps located on the
-//! path's Gaussian bridge.
+//! The thermally driven lever: the exact stochastic step of the piecewise-linear model and of
+//! SLS ([`ThermalExact`]), the exponential Euler step of the other laws, with the switchings
+//! the noise makes between two steps located on the path's Gaussian bridge.
 //!
 //! # The stochastic system
 //! In each region s the state z = (a, ȧ) obeys dz = (A_s z + f(τ)) dτ + G dW, the thermal force
@@ -46,6 +46,18 @@
 //! by the dyadic pieces of the ladder, each searched the same way, so the path stays on the
 //! ladder; a piece to a time off it (the run's end) has its own ladder, built on demand.
 //!
+//! # SLS: the dashpot's extension in the state
+//! The standard linear solid's sample (`crate::contact::sls`) is affine in each region in the
+//! state z = (a, ȧ, u), u the Maxwell arm's dashpot's extension: A_s is the model's Jacobian
+//! (constant in a region) and the forcing its right-hand side at z = 0, so the step above is
+//! exact in 2N + 1 dimensions about that system's own particular solution. The dashpot's
+//! thermal force ξ_d, white with 2 k_BT α6, enters α6 u̇ = κ(δ_s − u) + ξ_d: D_uu = 2 k_BT/α6
+//! (`state_diffusion`); the lever's is as above, and the sample adds no damping at the tip.
+//! The switching is where the tip meets the recovering surface, V_T + s(u) = 0
+//! (`crate::contact::Zener::surface`), in both regions: the bridge's tested row is
+//! g = (φ(1), 0, κ/(α4 + κ)) in place of the tip's. The free-flight certificate below is not
+//! used (the surface moves); every step is searched.
+//!
 //! # Nonlinear laws: the exponential Euler step
 //! For a law that is not piecewise linear but whose force is one of the state in each region
 //! (Hertz, DMT, the electrostatic law: a force F_c(δ, δ̇), the contact where V_T ≤ 0; JKR and
@@ -90,7 +102,6 @@
 //! does not depend on the samples asked for.
 
 use super::forcing::{harmonic_response, Forced};
-use super::tip::tip_v_t;
 use super::{ExactOptions, ExactPropagator};
 use crate::error::SimError;
 use crate::integrate::{Integrator, IntegratorOptions, Step};
@@ -167,26 +178,32 @@ pub(crate) fn drive_periods(model: &CantileverModel) -> usize {
     ((model.period() / t).round() as usize).max(1)
 }
 
-/// Whether the stochastic step can integrate `law`: the piecewise-linear law exactly, a law
-/// whose force is a function of the state in each region (Hertz, DMT, electrostatic, and the
-/// hysteretic JKR and capillary laws, whose region the run carries) by the exponential Euler
-/// step (module docs).
+/// Whether the stochastic step can integrate `law`: the piecewise-linear law and SLS (affine
+/// in each region, its dashpot's extension a state of its own) exactly, a law whose force is a
+/// function of the state in each region (Hertz, DMT, electrostatic, and the hysteretic JKR and
+/// capillary laws, whose region the run carries) by the exponential Euler step (module docs).
 ///
 /// # Errors
-/// [`SimError::Unsupported`] naming the law (SLS, whose dashpot's extension is a state of its
-/// own, and impact, whose state jumps and sticks: their stochastic integration is not built).
+/// [`SimError::Unsupported`] naming the law for impact, whose state jumps and sticks (its
+/// stochastic integration is not built).
 pub fn admits(law: &crate::contact::ContactLaw) -> Result<(), SimError> {
-    if law.internal_states() == 0 && law.restitution().is_none() {
+    if law.restitution().is_none() {
         return Ok(());
     }
     Err(SimError::Unsupported {
         integrator: "exact-thermal",
         law: law.name(),
         hint: "thermal noise (temperature) is simulated for the laws whose force is a function \
-               of the state (linear, hertz, dmt, electrostatic, jkr, capillary); this law's \
-               sample has a state of its own (sls) or jumps and sticks (impact): drop \
-               temperature for it",
+               of the state (linear, hertz, dmt, electrostatic, jkr, capillary) and for sls; \
+               the impact law's tip jumps and sticks: drop temperature for it",
     })
+}
+
+/// Whether the stochastic step advances `law` exactly: affine in each region (the linear law,
+/// and SLS with its dashpot's extension in the state); the other laws by the exponential Euler
+/// step (module docs).
+fn stepped_exactly(law: &crate::contact::ContactLaw) -> bool {
+    law.is_affine() || law.internal_states() > 0
 }
 
 /// [`admits`] for the law of `params` (under any drive: a multifrequency drive's further
@@ -210,28 +227,29 @@ struct Component {
     /// ps and pc (each `[2N]`).
     ps: DVector<f64>,
     pc: DVector<f64>,
-    /// Their tip deflections (tip·ps, tip·pc).
+    /// Their switching rows' values (g·ps, g·pc: the tip's deflections, with SLS's s(u)).
     tip: (f64, f64),
 }
 
 impl Component {
-    /// The further components of `lin`'s drive in region `r` (none for a single-frequency
-    /// drive).
+    /// The further components of the drive of `p` in the region's system `sys`, their tip
+    /// force on the state through `e` = (0, M⁻¹φ) (none for a single-frequency drive).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `drive_components.ratio` where ω is an undamped natural
     /// frequency of the region (no periodic response).
-    fn of(lin: &CantileverModel, r: Region) -> Result<Vec<Component>, SimError> {
-        let (p, n) = (lin.params(), lin.modes());
-        let mut e = DVector::zeros(2 * n);
-        e.rows_mut(n, n).copy_from(lin.tip_mobility());
+    fn of(
+        p: &crate::params::Params,
+        sys: &Affine,
+        e: &DVector<f64>,
+    ) -> Result<Vec<Component>, SimError> {
         p.components()
             .map(|c| {
                 let omega = c.ratio() * p.omega;
                 let (s, co) = c.phase.sin_cos();
-                let b = (&e * (-c.force * s), &e * (c.force * co));
-                let (ps, pc, _) = harmonic_response(&lin.dynamics(r).a, omega, (&b.0, &b.1))
-                    .ok_or_else(|| {
+                let b = (e * (-c.force * s), e * (c.force * co));
+                let (ps, pc, _) =
+                    harmonic_response(&sys.a, omega, (&b.0, &b.1)).ok_or_else(|| {
                         SimError::out_of_range(
                             "drive_components.ratio",
                             c.ratio(),
@@ -239,7 +257,7 @@ impl Component {
                              forced response (add damping)",
                         )
                     })?;
-                let tip = (lin.tip().dot(&ps.rows(0, n)), lin.tip().dot(&pc.rows(0, n)));
+                let tip = (sys.switching.dot(&ps), sys.switching.dot(&pc));
                 Ok(Component { omega, ps, pc, tip })
             })
             .collect()
@@ -255,7 +273,16 @@ impl Component {
 /// warning of a nonlinear law's scheme, whose own error is not zero
 /// (module docs): the run's document and the PI scan's warnings.
 pub fn thermal_method(law: &crate::contact::ContactLaw) -> (&'static str, Vec<String>) {
-    if law.is_affine() {
+    if law.internal_states() > 0 {
+        return (
+            "the fluctuation–dissipation theorem's white force on every mode (2 k_B T C_s) and \
+             on the SLS dashpot's extension (2 k_B T/α6), advanced by the exact stochastic step \
+             in 2N + 1 dimensions (Van Loan 1978), switchings onto the recovering surface \
+             located on the Gaussian bridge to h/4096 (crate::integrate::exact::noise)",
+            Vec::new(),
+        );
+    }
+    if stepped_exactly(law) {
         return (
             "the fluctuation–dissipation theorem's white force on every mode (2 k_B T C_s), \
              advanced by the exact stochastic step (Van Loan 1978), switchings between grid \
@@ -324,6 +351,26 @@ pub(crate) fn diffusion(model: &CantileverModel, r: Region, kt: f64) -> DMatrix<
     let block = &minv * c * minv.transpose() * (2.0 * kt);
     d.view_mut((n, n), (n, n))
         .copy_from(&(0.5 * (&block + block.transpose())));
+    d
+}
+
+/// GGᵀ of region `r` of `model` in the state's dimension: the lever's and the medium's (those of
+/// its linear part `lin`, [`diffusion`]) and under SLS its dashpot's own force, white with
+/// 2 k_BT α6 by the fluctuation–dissipation theorem, on the extension u:
+/// α6 u̇ = κ(δ_s − u) + ξ_d gives D_uu = 2 k_BT/α6 (the free sample's u then has
+/// k_BT/k_s, k_s = α4κ/(α4 + κ) its springs in series: equipartition).
+pub(crate) fn state_diffusion(
+    model: &CantileverModel,
+    lin: &CantileverModel,
+    r: Region,
+    kt: f64,
+) -> DMatrix<f64> {
+    let (dim, n) = (model.dim(), 2 * model.modes());
+    let mut d = DMatrix::zeros(dim, dim);
+    d.view_mut((0, 0), (n, n)).copy_from(&diffusion(lin, r, kt));
+    if model.zener().is_some() {
+        d[(n, n)] = 2.0 * kt / model.params().alpha6;
+    }
     d
 }
 
@@ -405,21 +452,121 @@ impl Far {
     }
 }
 
-/// z_F = −A⁻¹ (0, M⁻¹φ) and A⁻¹ z_F of the free region of `lin`, each with its tip deflection
-/// (module docs).
-fn unit_response(lin: &CantileverModel) -> Result<[(DVector<f64>, f64); 2], SimError> {
-    let n = lin.modes();
-    let mut e = DVector::zeros(2 * n);
-    e.rows_mut(n, n).copy_from(lin.tip_mobility());
-    let lu = lin.dynamics(Region::Free).a.clone().lu();
+/// z_F = −A⁻¹ e and A⁻¹ z_F of the free region's system `free`, e = (0, M⁻¹φ), each with its
+/// switching row's value (module docs).
+fn unit_response(free: &Affine, e: &DVector<f64>) -> Result<[(DVector<f64>, f64); 2], SimError> {
+    let lu = free.a.clone().lu();
     let singular = || SimError::out_of_range("stiffness matrix", "singular", "K must be SPD");
     let z = lu.solve(&(-e)).ok_or_else(singular)?;
     let z2 = lu.solve(&z).ok_or_else(singular)?;
     let tip = |z: DVector<f64>| {
-        let w = lin.tip().dot(&z.rows(0, n));
+        let w = free.switching.dot(&z);
         (z, w)
     };
     Ok([tip(z), tip(z2)])
+}
+
+/// A region's affine system ż = A z + b₀ + b_s sin Ωτ + b_c cos Ωτ (a multifrequency drive's
+/// further components aside, [`Component`]), its periodic particular solution
+/// z_p = p0 + ps sin Ωτ + pc cos Ωτ (A p0 = −b₀, [`harmonic_response`] for ps, pc) and the
+/// switching row g (`[dim]`): g·z is the tip's deflection W(1, τ), and under SLS W + s(u), the
+/// tip's height over the recovering surface less the base's and the gap's part of V_T
+/// ([`crate::contact::Zener::surface`]).
+#[derive(Debug, Clone)]
+struct Affine {
+    /// A (dim × dim).
+    a: DMatrix<f64>,
+    p0: DVector<f64>,
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    /// g·p0, g·ps, g·pc.
+    wp: [f64; 3],
+    switching: DVector<f64>,
+}
+
+impl Affine {
+    /// Region `r` of `model`: its linear part `lin` with the deterministic propagator's
+    /// particular solution `det`, or under SLS the model's own system in 2N + 1 dimensions,
+    /// A its Jacobian (constant in a region) and b its right-hand side at z = 0 less the
+    /// further components' force.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `omega` at an undamped natural frequency of SLS's
+    /// system (no periodic response).
+    fn of(
+        model: &CantileverModel,
+        lin: &CantileverModel,
+        det: &ExactPropagator,
+        r: Region,
+    ) -> Result<Affine, SimError> {
+        let (n, dim) = (model.modes(), model.dim());
+        let mut switching = DVector::zeros(dim);
+        switching.rows_mut(0, n).copy_from(model.tip());
+        let Some(zn) = model.zener() else {
+            let f: &Forced = &det.forced[r.index()];
+            let parts = (f.p0.clone(), f.ps.clone(), f.pc.clone());
+            return Ok(Self::with(lin.dynamics(r).a.clone(), parts, switching));
+        };
+        switching[2 * n] = zn.surface_gain();
+        let p = model.params();
+        let zero = vec![0.0; dim];
+        let mut a = DMatrix::zeros(dim, dim);
+        model.jacobian_into(r, 0.0, &zero, &mut a);
+        let fd = if p.is_multifrequency() {
+            p.component_force(0.0)
+        } else {
+            0.0
+        };
+        let b = |sc: (f64, f64)| {
+            let mut out = DVector::zeros(dim);
+            model.rhs_slice_at(r, 0.0, sc, &zero, out.as_mut_slice());
+            out.rows_mut(n, n).axpy(-fd, model.tip_mobility(), 1.0);
+            out
+        };
+        let (up, down) = (b((0.0, 1.0)), b((0.0, -1.0)));
+        let b0 = 0.5 * (&up + &down);
+        let bc = 0.5 * (up - down);
+        let bs = b((1.0, 0.0)) - &b0;
+        let resonance = || {
+            SimError::out_of_range(
+                "omega",
+                p.omega,
+                "is an undamped natural frequency of the lever on the SLS sample: no periodic \
+                 forced response (add damping)",
+            )
+        };
+        let p0 = a.clone().lu().solve(&(-b0)).ok_or_else(resonance)?;
+        let (ps, pc, _) = harmonic_response(&a, p.omega, (&bs, &bc)).ok_or_else(resonance)?;
+        Ok(Self::with(a, (p0, ps, pc), switching))
+    }
+
+    fn with(
+        a: DMatrix<f64>,
+        (p0, ps, pc): (DVector<f64>, DVector<f64>, DVector<f64>),
+        switching: DVector<f64>,
+    ) -> Affine {
+        let wp = [&p0, &ps, &pc].map(|p| switching.dot(p));
+        Affine {
+            a,
+            p0,
+            ps,
+            pc,
+            wp,
+            switching,
+        }
+    }
+
+    /// Both regions' ([`Affine::of`]).
+    fn both(
+        model: &CantileverModel,
+        lin: &CantileverModel,
+        det: &ExactPropagator,
+    ) -> Result<[Affine; 2], SimError> {
+        Ok([
+            Self::of(model, lin, det, Region::Free)?,
+            Self::of(model, lin, det, Region::Contact)?,
+        ])
+    }
 }
 
 /// The least of c₀ + R sin θ over θ ∈ [θ₀, θ₁].
@@ -468,10 +615,9 @@ impl Bridge {
         let gain = &q1 * phi2.transpose() * pinv(q);
         let cov = &q1 - &gain * phi2 * &q1;
         let root = root(&(0.5 * (&cov + cov.transpose())));
-        let n = tip.len();
-        let tip_sd = (root.rows(0, n).transpose() * tip).norm();
-        let v = gain.rows(0, n).transpose() * tip;
-        let u = phi1.rows(0, n).transpose() * tip - phi.transpose() * &v;
+        let tip_sd = (root.transpose() * tip).norm();
+        let v = gain.transpose() * tip;
+        let u = phi1.transpose() * tip - phi.transpose() * &v;
         Bridge {
             phi1,
             gain,
@@ -563,6 +709,8 @@ pub struct ThermalExact {
     /// Its linear part, which the steps advance exactly: the model under the linear law, the
     /// lever without the sample under a nonlinear one ([`linear_part`]).
     lin: CantileverModel,
+    /// Both regions' affine systems and particular solutions (the primary drive's).
+    affine: [Affine; 2],
     /// z_F = −A⁻¹ (0, M⁻¹φ) and A⁻¹ z_F (each `[2N]`) and their tip deflections: the free
     /// lever's response to a unit tip force and to a unit rate of it (module docs).
     unit: [(DVector<f64>, f64); 2],
@@ -612,8 +760,9 @@ impl ThermalExact {
     /// to resolve the fastest mode).
     ///
     /// # Errors
-    /// [`SimError::Unsupported`] naming the law for a law that is not piecewise linear (the
-    /// nonlinear laws' stochastic integration is not built); the exact propagator's.
+    /// [`SimError::Unsupported`] naming the impact law ([`admits`]); the exact propagator's;
+    /// [`SimError::OutOfRange`] naming `omega` or `drive_components.ratio` at an undamped
+    /// natural frequency.
     pub fn new(
         model: &CantileverModel,
         opts: &IntegratorOptions,
@@ -628,26 +777,33 @@ impl ThermalExact {
         };
         let lin = linear_part(model)?;
         let det = ExactPropagator::try_with(&lin, exact.clone())?;
-        let diffusion = [Region::Free, Region::Contact].map(|r| diffusion(&lin, r, force.kt));
-        let h = det.grid.h;
-        let omega = model.omega();
-        let ladders = [Region::Free, Region::Contact].map(|r| {
-            let a = &lin.dynamics(r).a;
-            ladder(a, &diffusion[r.index()], h, model.tip(), omega)
+        let affine = Affine::both(model, &lin, &det)?;
+        let regions = [Region::Free, Region::Contact];
+        let diffusion = regions.map(|r| state_diffusion(model, &lin, r, force.kt));
+        let (h, omega) = (det.grid.h, model.omega());
+        let ladders = regions.map(|r| {
+            let sys = &affine[r.index()];
+            ladder(&sys.a, &diffusion[r.index()], h, &sys.switching, omega)
         });
-        let n = 2 * model.modes();
-        let far = Far::new(&lin, &diffusion[Region::Free.index()], force.kt)
-            .filter(|_| !model.law().acts_outside());
-        let unit = unit_response(&lin)?;
+        let n = model.dim();
+        // (none over SLS, whose recovering surface is a state of its own)
+        let far = (!model.law().acts_outside() && model.zener().is_none())
+            .then(|| Far::new(&lin, &diffusion[Region::Free.index()], force.kt))
+            .flatten();
+        let mut e = DVector::zeros(n);
+        e.rows_mut(model.modes(), model.modes())
+            .copy_from(model.tip_mobility());
+        let unit = unit_response(&affine[0], &e)?;
         let components = [
-            Component::of(&lin, Region::Free)?,
-            Component::of(&lin, Region::Contact)?,
+            Component::of(model.params(), &affine[0], &e)?,
+            Component::of(model.params(), &affine[1], &e)?,
         ];
         Ok(ThermalExact {
             det,
             exact,
             model: model.clone(),
             lin,
+            affine,
             unit,
             components,
             frozen: [0.0; 3],
@@ -723,7 +879,7 @@ impl ThermalExact {
     /// z_p(τ) of region `r` at (sin, cos) Ωτ = `sc`: the primary drive's and the further
     /// components'.
     fn zp(&self, r: Region, tau: f64, (s, c): (f64, f64)) -> DVector<f64> {
-        let f: &Forced = &self.det.forced[r.index()];
+        let f = &self.affine[r.index()];
         let mut z = f.p0.clone();
         z.axpy(s, &f.ps, 1.0);
         z.axpy(c, &f.pc, 1.0);
@@ -778,7 +934,7 @@ impl ThermalExact {
         z: &DVector<f64>,
         out: &mut DVector<f64>,
     ) {
-        let f: &Forced = &self.det.forced[r.index()];
+        let f = &self.affine[r.index()];
         out.copy_from(z);
         *out -= &f.p0;
         out.axpy(-s, &f.ps, 1.0);
@@ -795,7 +951,8 @@ impl ThermalExact {
     /// |δ_f| − V_T there under a hysteretic law (JKR's neck, the capillary meniscus: left at
     /// V_T = |δ_f|, [`crate::contact::ContactLaw::release_distance`]).
     fn gap(&self, r: Region, sc: (f64, f64), z: &DVector<f64>) -> f64 {
-        self.gap_of(r, tip_v_t(self.model(), z.as_slice(), sc).0)
+        let w = self.affine[r.index()].switching.dot(z);
+        self.gap_of(r, self.model().v_t_at(sc, [w, 0.0, 0.0])[0])
     }
 
     /// [`ThermalExact::gap`] in region `r` at V_T = `v`.
@@ -818,7 +975,7 @@ impl ThermalExact {
         da: &DVector<f64>,
         db: &DVector<f64>,
     ) -> f64 {
-        let [w0, ws, wc] = self.det.forced[r.index()].wp;
+        let [w0, ws, wc] = self.affine[r.index()].wp;
         let [u, v] = &rung.mid.rows;
         let [c1, c2] = self.shift(tm);
         let forced = c1 * self.unit[0].1 + c2 * self.unit[1].1 + self.components_tip(r, tm);
@@ -877,10 +1034,9 @@ impl ThermalExact {
         let rungs = match &self.odd {
             Some((r, l, rungs)) if *r == self.region && *l == len => rungs.clone(),
             _ => {
-                let m = &self.lin;
                 let r = self.region;
-                let (a, d) = (&m.dynamics(r).a, &self.diffusion[r.index()]);
-                let rungs = ladder(a, d, len, m.tip(), m.omega());
+                let (sys, d) = (&self.affine[r.index()], &self.diffusion[r.index()]);
+                let rungs = ladder(&sys.a, d, len, &sys.switching, self.model.omega());
                 self.odd = Some((r, len, rungs.clone()));
                 rungs
             }
@@ -924,7 +1080,7 @@ impl ThermalExact {
 
     /// Whether the law is nonlinear (the exponential Euler step, module docs).
     fn nonlinear(&self) -> bool {
-        !self.model.law().is_affine()
+        !stepped_exactly(self.model.law())
     }
 
     /// Take `piece` in the current region: draw its end, search it for a switching; the first
@@ -977,7 +1133,7 @@ impl ThermalExact {
     /// Whether a free-flight step from τ₀ to τ₁ is certified from δz at τ₀ (module docs).
     fn certified(&self, far: &Far, t0: f64, t1: f64, dz0: &DVector<f64>) -> bool {
         let b = super::tip::base_amp(self.model().params());
-        let [w0, ws, wc] = self.det.forced[Region::Free.index()].wp;
+        let [w0, ws, wc] = self.affine[Region::Free.index()].wp;
         let (c0, r) = (self.model().params().alpha5 + w0, (ws + b).hypot(wc));
         let phase = wc.atan2(ws + b);
         let omega = self.model().omega();
@@ -996,7 +1152,7 @@ impl ThermalExact {
         if let Some((_, f)) = self.flights.iter().find(|(k, _)| *k == c) {
             return f.clone();
         }
-        let a = &self.lin.dynamics(Region::Free).a;
+        let a = &self.affine[Region::Free.index()].a;
         let d = &self.diffusion[Region::Free.index()];
         let (phi, q) = van_loan(a, d, c as f64 * self.det.grid.h);
         let f = Arc::new((phi, root(&q)));
@@ -1080,8 +1236,8 @@ impl ThermalExact {
 
 impl Integrator for ThermalExact {
     current_fields!();
-    /// `exact-thermal` under the linear law; `exponential-euler-thermal` under a nonlinear one
-    /// (the step is then first order in its pieces, module docs).
+    /// `exact-thermal` under the linear law and SLS; `exponential-euler-thermal` under a
+    /// nonlinear one (the step is then first order in its pieces, module docs).
     fn name(&self) -> &'static str {
         if self.nonlinear() {
             "exponential-euler-thermal"
@@ -1099,13 +1255,14 @@ impl Integrator for ThermalExact {
         if model.set_gap(alpha5).is_err() || lin.set_gap(alpha5).is_err() {
             return false;
         }
-        match ExactPropagator::try_with(&lin, self.exact.clone()) {
-            Ok(det) => {
-                (self.model, self.lin, self.det) = (model, lin, det);
-                true
-            }
-            Err(_) => false,
-        }
+        let Ok(det) = ExactPropagator::try_with(&lin, self.exact.clone()) else {
+            return false;
+        };
+        let Ok(affine) = Affine::both(&model, &lin, &det) else {
+            return false;
+        };
+        (self.model, self.lin, self.det, self.affine) = (model, lin, det, affine);
+        true
     }
 
     fn reset_in(&mut self, tau: f64, z: &DVector<f64>, region: Region) -> Result<(), SimError> {
@@ -1201,15 +1358,10 @@ impl Integrator for ThermalExact {
         let r = self.last_region;
         // the bridge of the piece the point lies in: its frozen force, b's
         let frozen: Frozen = std::mem::replace(&mut self.frozen, fb);
-        let m = &self.lin;
-        let bridge = Bridge::new(
-            &m.dynamics(r).a,
-            &self.diffusion[r.index()],
-            tau - ta,
-            tb - tau,
-            m.tip(),
-        );
-        let omega = m.omega();
+        let sys = &self.affine[r.index()];
+        let d = &self.diffusion[r.index()];
+        let bridge = Bridge::new(&sys.a, d, tau - ta, tb - tau, &sys.switching);
+        let omega = self.model.omega();
         let [sa, st, sb] = [ta, tau, tb].map(|t| (omega * t).sin_cos());
         let (mut da, mut db) = (DVector::zeros(za.len()), DVector::zeros(zb.len()));
         self.dz_into(r, ta, sa, &za, &mut da);
