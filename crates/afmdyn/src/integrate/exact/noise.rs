@@ -55,8 +55,9 @@
 //! (`state_diffusion`); the lever's is as above, and the sample adds no damping at the tip.
 //! The switching is where the tip meets the recovering surface, V_T + s(u) = 0
 //! (`crate::contact::Zener::surface`), in both regions: the bridge's tested row is
-//! g = (φ(1), 0, κ/(α4 + κ)) in place of the tip's. The free-flight certificate below is not
-//! used (the surface moves); every step is searched.
+//! g = (φ(1), 0, κ/(α4 + κ)) in place of the tip's. The grid resolves the contact at its
+//! instantaneous stiffness α4 + κ (`grid_model`), as the linear law's does its own. The
+//! free-flight certificate below is not used (the surface moves); every step is searched.
 //!
 //! # Nonlinear laws: the exponential Euler step
 //! For a law that is not piecewise linear but whose force is one of the state in each region
@@ -318,6 +319,24 @@ pub(crate) fn linear_part(model: &CantileverModel) -> Result<CantileverModel, Si
     let p = crate::params::Params {
         contact_law: crate::contact::ContactLaw::Linear,
         alpha4: 0.0,
+        alpha6: 0.0,
+        ..*model.params()
+    };
+    Ok(CantileverModel::new(&p)?)
+}
+
+/// The model whose exact propagator gives the stochastic step's grid: the linear part `lin`, or
+/// over SLS the lever on a linear sample of the instantaneous stiffness α4 + κ, so that the
+/// grid resolves the contact's fastest oscillation as under the linear law (‖A‖₂ h ≤ θ:
+/// a contact lasts longer than half a grid step, so that the bridge's test points, h/2 apart,
+/// meet it as T → 0).
+fn grid_model(model: &CantileverModel, lin: &CantileverModel) -> Result<CantileverModel, SimError> {
+    let Some(zn) = model.zener() else {
+        return Ok(lin.clone());
+    };
+    let p = crate::params::Params {
+        contact_law: crate::contact::ContactLaw::Linear,
+        alpha4: zn.relaxed + zn.maxwell,
         alpha6: 0.0,
         ..*model.params()
     };
@@ -776,7 +795,7 @@ impl ThermalExact {
             ..ExactOptions::default()
         };
         let lin = linear_part(model)?;
-        let det = ExactPropagator::try_with(&lin, exact.clone())?;
+        let det = ExactPropagator::try_with(&grid_model(model, &lin)?, exact.clone())?;
         let affine = Affine::both(model, &lin, &det)?;
         let regions = [Region::Free, Region::Contact];
         let diffusion = regions.map(|r| state_diffusion(model, &lin, r, force.kt));
@@ -1255,13 +1274,17 @@ impl Integrator for ThermalExact {
         if model.set_gap(alpha5).is_err() || lin.set_gap(alpha5).is_err() {
             return false;
         }
-        let Ok(det) = ExactPropagator::try_with(&lin, self.exact.clone()) else {
+        // (over SLS the grid's propagator does not depend on the gap: kept)
+        if model.zener().is_none() {
+            let Ok(det) = ExactPropagator::try_with(&lin, self.exact.clone()) else {
+                return false;
+            };
+            self.det = det;
+        }
+        let Ok(affine) = Affine::both(&model, &lin, &self.det) else {
             return false;
         };
-        let Ok(affine) = Affine::both(&model, &lin, &det) else {
-            return false;
-        };
-        (self.model, self.lin, self.det, self.affine) = (model, lin, det, affine);
+        (self.model, self.lin, self.affine) = (model, lin, affine);
         true
     }
 
