@@ -385,13 +385,7 @@ fn an_sls_chain_converges_in_its_parts() {
     let z = orbit(&model, integ.state());
     let kt = kt_model(&p);
     let variances = |parts: usize| {
-        let opts = IntegratorOptions::default();
-        let mut walk = Walk::new(&model, &z, kt, 0, opts).unwrap();
-        let mut contact = false;
-        for k in 1..=parts {
-            walk.part(model.period() * k as f64 / parts as f64).unwrap();
-            contact |= walk.region == Region::Contact;
-        }
+        let (walk, contact) = walked(&model, &z, kt, parts);
         assert!(contact, "the orbit taps");
         let y = walk.chain.stationary().expect("a stable orbit");
         [y[(0, 0)], y[(1, 1)]]
@@ -401,6 +395,23 @@ fn an_sls_chain_converges_in_its_parts() {
     for (c, f) in coarse.iter().zip(&fine) {
         assert!((c / f - 1.0).abs() < 1e-3, "{coarse:?} vs {fine:?}");
     }
+}
+
+/// The walk of `model`'s orbit through `z` at `kt` over one period in `parts` equal parts, and
+/// whether it passed through contact.
+fn walked<'a>(
+    model: &'a CantileverModel,
+    z: &DVector<f64>,
+    kt: f64,
+    parts: usize,
+) -> (Walk<'a>, bool) {
+    let mut walk = Walk::new(model, z, kt, 0, IntegratorOptions::default()).unwrap();
+    let mut contact = false;
+    for k in 1..=parts {
+        walk.part(model.period() * k as f64 / parts as f64).unwrap();
+        contact |= walk.region == Region::Contact;
+    }
+    (walk, contact)
 }
 
 /// JKR's neck holds the tip at V_T > 0, where the state alone says free flight: the walk carries
@@ -618,12 +629,8 @@ fn an_impacting_chain_converges_in_its_parts() {
         );
         let kt = kt_model(&p);
         let variances = |parts: usize| {
-            let opts = IntegratorOptions::default();
-            let mut walk = Walk::new(&model, &z, kt, 0, opts).unwrap();
-            for k in 1..=parts {
-                walk.part(model.period() * k as f64 / parts as f64).unwrap();
-            }
-            let y = walk.chain.stationary().expect("a stable orbit");
+            let y = walked(&model, &z, kt, parts).0.chain;
+            let y = y.stationary().expect("a stable orbit");
             [y[(0, 0)], y[(1, 1)]]
         };
         let (coarse, fine) = (variances(512), variances(32_768));
@@ -661,10 +668,7 @@ fn an_impacting_chain_is_the_simulated_oscillators() {
     let model = CantileverModel::new(&p.params).unwrap();
     let z0 = settled_orbit(&model);
     let kt = kt_model(&p);
-    let mut walk = Walk::new(&model, &z0, kt, 0, IntegratorOptions::default()).unwrap();
-    for k in 1..=4096 {
-        walk.part(model.period() * k as f64 / 4096.0).unwrap();
-    }
+    let walk = walked(&model, &z0, kt, 4096).0;
     let chain = walk.chain.stationary().expect("a stable orbit");
     // the deterministic map's monodromy by central differences (DOP853 at 10⁻¹²)
     let opts = IntegratorOptions {
