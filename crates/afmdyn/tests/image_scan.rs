@@ -612,14 +612,10 @@ fn a_thermal_scan_is_its_seeds() {
     let sls_bias = bias(&sls);
     println!("SLS at T → 0: heights {sls_bias:.3} pm from the deterministic scan's");
     assert!(sls_bias < 5.0, "{sls_bias} pm");
-    // the impact law (its tip jumps and sticks) has no stochastic step: refused naming it
-    let s = PiScan {
-        temperature: Some(295.0),
-        ..PiScan::default()
-    };
+    // an impact domain (its impacts and sticking the step's events): at T → 0 its pixels are
+    // the deterministic scan's within the DMT background's error
     let impact = stripe("law = \"impact\"\nrestitution = 0.5\n");
-    match pi_image(&dmt, &impact, &short, &s, Some(1), &Progress::new()) {
-        Err(SimError::Unsupported { law, .. }) => assert_eq!(law, "impact"),
-        other => panic!("{:?}", other.map(|_| ())),
-    }
+    let impact_bias = bias(&impact);
+    println!("impact at T → 0: heights {impact_bias:.3} pm from the deterministic scan's");
+    assert!(impact_bias < 5.0, "{impact_bias} pm");
 }

@@ -330,11 +330,11 @@ def image(
         time_constant: the PI scan's lock-in time constant (s), refused above 1000 s and
             warned outside 1 µs–0.1 s (``None``: the lever's default).
         temperature: the temperature (K; ``None``: no thermal noise). A PI scan's: the
-            lever's thermal force on every line (every law but impact), so that the
-            amplitude, phase, height and error images carry the noise of the lock-in's
-            bandwidth. With ``mode="peakforce"``: the maps ``peak_force_noise`` and
-            ``deformation_noise``, each pixel's σ from cycle to cycle (its material's tap at
-            the setpoint, by linear response).
+            lever's thermal force on every line (every law), so that the amplitude, phase,
+            height and error images carry the noise of the lock-in's bandwidth. With
+            ``mode="peakforce"``: the maps ``peak_force_noise`` and ``deformation_noise``,
+            each pixel's σ from cycle to cycle (its material's tap at the setpoint, by
+            linear response).
         seed: the seed of the PI scan's thermal force (with ``temperature``): the image is a
             function of it, whatever the threads or the executor.
         mode: ``"am"`` or ``"peakforce"`` (an off-resonance probe).

@@ -34,9 +34,9 @@
 //! in ([`crate::system::HybridSystem::mode_at`]).
 //!
 //! The impact law's jumps are the flow's saltation matrices (Leine & Nijmeijer 2004, ch. 7). While
-//! it sticks, the constraint's reaction takes the thermal force's part at the tip: from
-//! M ä = f + φλ with φᵀä = 0 the velocity block of the diffusion is P D_vv Pᵀ,
-//! P = I − m_eff M⁻¹φ φᵀ (φᵀP = 0), and the motion is affine with the sticking field's Jacobian
+//! it sticks, the constraint's reaction takes the thermal force's part at the tip (the diffusion
+//! projected onto no tip acceleration, [`state_diffusion`]), and the motion is affine with the
+//! sticking field's Jacobian
 //! (the constraint held by its Baumgarte terms), so its parts are exact too. A beam pinned so
 //! at its tip fluctuates as equipartition conditioned on φᵀa fixed.
 //!
@@ -195,13 +195,8 @@ impl<'a> Walk<'a> {
         // the model's own matrix (module docs)
         let zener = model.params().contact_law.internal_states() > 0;
         let sticks = model.params().contact_law.restitution().is_some();
-        let d = [Region::Free, Region::Contact].map(|r| {
-            let mut d = state_diffusion(model, &linear, r, kt);
-            if sticks && r == Region::Contact {
-                constrain(model, &mut d);
-            }
-            d
-        });
+        // (sticking's projected onto no tip acceleration, `state_diffusion`)
+        let d = [Region::Free, Region::Contact].map(|r| state_diffusion(model, &linear, r, kt));
         let n = z.len() + observers;
         let (region, force, force_u) = tip_force(model, 0.0, z, model.mode_at(0.0, z.as_slice()));
         Ok(Walk {
@@ -305,24 +300,6 @@ impl<'a> Walk<'a> {
         (self.state, self.tau, self.region) = (fl.state, t1, to);
         (self.force, self.force_u) = (force, force_u);
     }
-}
-
-/// The diffusion `d` (shape `[dim, dim]`) of a tip held on the surface (the impact law's
-/// sticking): the constraint's reaction takes the thermal force's part at the tip, so the
-/// velocity block becomes P D_vv Pᵀ, P = I − m_eff M⁻¹φ φᵀ (φᵀP = 0: no tip acceleration),
-/// from M ä = f + φλ with φᵀä = 0.
-fn constrain(model: &CantileverModel, d: &mut DMatrix<f64>) {
-    let n = model.modes();
-    let mut p = DMatrix::identity(n, n);
-    p.ger(
-        -model.effective_mass(),
-        model.tip_mobility(),
-        model.tip(),
-        1.0,
-    );
-    let vv = &p * d.view((n, n), (n, n)) * p.transpose();
-    d.view_mut((n, n), (n, n))
-        .copy_from(&(0.5 * (&vv + vv.transpose())));
 }
 
 /// The law's tip force at (τ, `z`) in region `r` of `model` and its rate ∂F_c/∂u on SLS's

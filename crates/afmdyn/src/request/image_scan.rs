@@ -54,8 +54,8 @@ request! {
         pub time_constant: Option<f64>,
         /// The temperature T of the thermal force on the lever (K, > 0 and ≤ 1500; outside
         /// 200–500 K it warns, a value in °C?); `None` (the default): no thermal noise. With one
-        /// the lines are integrated by the stochastic step (exact for the linear law and SLS,
-        /// exponential Euler for the other laws; the impact law is refused),
+        /// the lines are integrated by the stochastic step (exact for the linear law, SLS and
+        /// the impact law, exponential Euler for the other laws),
         /// and the lock-in's amplitude and phase, the height and the error
         /// images carry the noise the lever's thermal motion gives them at the lock-in's
         /// bandwidth (the pixels' energy residual is then not given: the balance leaves the

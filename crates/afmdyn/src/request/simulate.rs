@@ -48,10 +48,11 @@ request! {
         /// a value in °C?); `None` (the default): no thermal noise, the deterministic run. Each
         /// mode's equation then carries the white force the fluctuation–dissipation theorem gives
         /// for its damping (the lever's, the medium's, in contact the linear law's dashpot, SLS's
-        /// on its dashpot's extension), advanced by the exact stochastic step of the linear law
-        /// and SLS, or the exponential Euler step of Hertz, DMT, the electrostatic law, JKR and
-        /// the capillary meniscus (their region the run's own; `crate::integrate::exact::noise`).
-        /// Needs the probe's SI units (`--probe`); the impact law is refused; not with
+        /// on its dashpot's extension), advanced by the exact stochastic step of the linear law,
+        /// SLS and the impact law (its impacts on the bridge, its sticking holding the tip
+        /// against the force's part at it), or the exponential Euler step of Hertz, DMT, the
+        /// electrostatic law, JKR and the capillary meniscus (their region the run's own;
+        /// `crate::integrate::exact::noise`). Needs the probe's SI units (`--probe`); not with
         /// `energy_balance`. Under a
         /// multifrequency drive each further component adds its particular solution.
         pub temperature: Option<f64>,

@@ -80,15 +80,11 @@ pub(crate) fn material_curves(
     map: &SampleMap,
     curve_points: usize,
     extra: Cost,
-    admit: &dyn Fn(&Params) -> Result<(), SimError>,
 ) -> Result<(Vec<MaterialCurve>, Vec<usize>, CurveUnits), SimError> {
     let background = background_probe(probe_table)?;
     let units = CurveUnits::from_scales(&background.scales, false);
     check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
     let (models, of_domain, warnings) = material_models(probe_table, map, &background)?;
-    for (_, params) in &models {
-        admit(params)?;
-    }
     let materials = models
         .into_iter()
         .zip(warnings)
@@ -197,8 +193,7 @@ pub fn image(
         bytes: req.pixel_bytes(map),
         work: 0.0,
     };
-    let (curves, of_domain, units) =
-        material_curves(probe_table, map, req.curve_points, extra, &|_| Ok(()))?;
+    let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points, extra)?;
     image_of(&curves, &of_domain, &units, map, req)
 }
 
@@ -417,8 +412,7 @@ pub fn setpoint_study(
         bytes: 0.0,
         work: 0.0,
     };
-    let (curves, of_domain, units) =
-        material_curves(probe_table, map, curve_points, extra, &|_| Ok(()))?;
+    let (curves, of_domain, units) = material_curves(probe_table, map, curve_points, extra)?;
     let names = std::iter::once(("background".to_string(), 0, 0.0)).chain(
         map.domains
             .iter()

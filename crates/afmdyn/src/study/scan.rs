@@ -158,16 +158,8 @@ impl ScanStudy {
             bytes: req.pixel_bytes(map),
             work: total,
         };
-        let (curves, of_domain, units) = material_curves(
-            probe_table,
-            map,
-            req.curve_points,
-            extra,
-            &|p| match scan.temperature {
-                Some(_) => crate::integrate::exact::noise::admits(&p.contact_law),
-                None => Ok(()),
-            },
-        )?;
+        let (curves, of_domain, units) =
+            material_curves(probe_table, map, req.curve_points, extra)?;
         let ideal = image_of(&curves, &of_domain, &units, map, req)?;
         let engage = curves
             .iter()
