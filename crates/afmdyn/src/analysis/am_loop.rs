@@ -341,8 +341,7 @@ type Kept = (CantileverModel, Box<dyn Integrator>);
 /// from gap to gap, so that its random stream goes on.
 ///
 /// # Errors
-/// As [`CantileverModel::new`], [`build`] and [`ThermalExact::new`] (the impact law with a
-/// thermal force).
+/// As [`CantileverModel::new`], [`build`] and [`ThermalExact::new`].
 fn at_gap<'a>(
     kept: &'a mut Option<Kept>,
     mat: &Params,

@@ -257,7 +257,7 @@ pub struct SimulatedTapNoise {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `cycles` (below [`MIN_THERMAL_CYCLES`]); the stochastic
-/// step's ([`crate::integrate::exact::ThermalExact::new`]: the impact law);
+/// step's ([`crate::integrate::exact::ThermalExact::new`]);
 /// [`SimError::Cancelled`] when the run's watched flag is set.
 pub fn simulated_tap_noise(
     model: &CantileverModel,
