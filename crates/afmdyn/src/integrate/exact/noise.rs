@@ -86,8 +86,10 @@
 //! water within 10⁻¹⁵ m. The number of impacts and the time stuck therefore depend on the grid
 //! while the motion does not (the run warns, `thermal.impact-chatter`). At T → 0 the step is
 //! the deterministic run's (impact map, chattering ending in sticking, release at λ = 0), but
-//! for a grazing impact that dips across the surface between the bridge's test points, which
-//! the noise's κσ band catches at a temperature and a finer grid at T → 0.
+//! for a grazing impact that dips across the surface between the bridge's test points deeper
+//! than the noise's κσ band there (at T → 0, any): where the tip moves faster than the grid
+//! (higher modes ringing after an impact, a fast drive component) a finer grid finds it (a
+//! simulation's grid holds its samples: more samples per period).
 //!
 //! # Nonlinear laws: the exponential Euler step
 //! For a law that is not piecewise linear but whose force is one of the state in each region
