@@ -579,18 +579,17 @@ impl Affine {
         let (n, dim) = (model.modes(), model.dim());
         let mut switching = DVector::zeros(dim);
         switching.rows_mut(0, n).copy_from(model.tip());
-        let stuck = sticking(model, r);
+        let (stuck, zero) = (sticking(model, r), vec![0.0; dim]);
         if let Some(zn) = model.zener() {
             switching[2 * n] = zn.surface_gain();
         } else if stuck {
-            switching = model.guard(r, 0.0, &vec![0.0; dim]).grad;
+            switching = model.guard(r, 0.0, &zero).grad;
         } else {
             let f: &Forced = &det.forced[r.index()];
             let parts = (f.p0.clone(), f.ps.clone(), f.pc.clone());
             return Ok(Self::with(lin.dynamics(r).a.clone(), parts, switching));
         }
         let p = model.params();
-        let zero = vec![0.0; dim];
         let mut a = DMatrix::zeros(dim, dim);
         model.jacobian_into(r, 0.0, &zero, &mut a);
         // the right-hand side at Ωτ = θ: the further components' force taken out (the sticking
@@ -1090,9 +1089,14 @@ impl ThermalExact {
         t <= tau_max + self.slack(tau_max)
     }
 
+    /// δ = h/2^[`LEVELS`], the ladder's finest piece: the resolution of a switching's time.
+    fn resolution(&self) -> f64 {
+        self.det.grid.h / (1u64 << LEVELS) as f64
+    }
+
     /// τ of ladder position (j, i).
     fn lattice_tau(&self, (j, i): (i64, u64)) -> f64 {
-        self.det.grid.tau(j) + i as f64 * self.det.grid.h / (1u64 << LEVELS) as f64
+        self.det.grid.tau(j) + i as f64 * self.resolution()
     }
 
     /// The next piece from the current state towards `tau_max`.
@@ -1225,18 +1229,22 @@ impl ThermalExact {
     }
 
     /// The event at the first point `z` across the surface from region `from` at `tau`: its
-    /// region after, kind and state after: a switching (the state unchanged), or under the
-    /// impact law a release from sticking or an impact ([`ThermalExact::impact`]).
+    /// region after, kind and the state after where it moves: a switching (the state
+    /// unchanged), or under the impact law a release from sticking (unchanged) or an impact
+    /// ([`ThermalExact::impact`]).
     fn event_at(
         &self,
         from: Region,
         tau: f64,
         z: &DVector<f64>,
-    ) -> (Region, EventKind, DVector<f64>) {
+    ) -> (Region, EventKind, Option<DVector<f64>>) {
         match (self.model.law().restitution(), from) {
-            (None, _) => (from.other(), EventKind::Switching, z.clone()),
-            (Some(_), Region::Contact) => (Region::Free, EventKind::Release, z.clone()),
-            (Some(r), Region::Free) => self.impact(r, tau, z),
+            (None, _) => (from.other(), EventKind::Switching, None),
+            (Some(_), Region::Contact) => (Region::Free, EventKind::Release, None),
+            (Some(r), Region::Free) => {
+                let (to, kind, after) = self.impact(r, tau, z);
+                (to, kind, Some(after))
+            }
         }
     }
 
@@ -1253,7 +1261,7 @@ impl ThermalExact {
     fn impact(&self, r: f64, tau: f64, z: &DVector<f64>) -> (Region, EventKind, DVector<f64>) {
         let m = &self.model;
         let (n, k, mobility) = (m.modes(), m.effective_mass(), m.tip_mobility());
-        let delta = self.det.grid.h / (1u64 << LEVELS) as f64;
+        let delta = self.resolution();
         let (g, v) = (m.v_t(tau, z), m.v_t_dot(tau, z));
         let mut rate = DVector::zeros(z.len());
         m.rhs(Region::Free, tau, z, &mut rate);
@@ -1469,11 +1477,11 @@ impl Integrator for ThermalExact {
                     }
                 });
                 self.at = self.at.filter(|_| piece.3.is_none());
-                let (to, kind, z) = self.event_at(from, tc, &zc);
+                let (to, kind, moved) = self.event_at(from, tc, &zc);
                 let step = Step::with_event(self.model(), tau0, from, tc, &zc, to, kind);
                 self.tau = tc;
                 self.sc = (self.model().omega() * tc).sin_cos();
-                self.z = z;
+                self.z = moved.unwrap_or(zc);
                 self.region = to;
                 return Ok(step);
             }
