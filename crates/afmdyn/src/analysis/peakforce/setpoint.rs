@@ -5,8 +5,9 @@
 //! g(α5) = F_peak(α5) − F_set is bracketed from α5 = α2 (the sample's lowest point at the
 //! rest position of the tip: no repulsive contact quasi-statically) downward in doubling
 //! steps, then found by the Illinois variant of false position (Dowell & Jarratt, *BIT* 11
-//! (1971) 168), which keeps the bracket. A setpoint that no z_c reaches within the bracket's
-//! budget is refused with [`SimError::OutOfRange`] naming `setpoint`.
+//! (1971) 168), which keeps the bracket; a point whose tap does not settle (it grazes) closes
+//! the bracket from the far side, and the next point bisects it. A setpoint that no z_c reaches
+//! within the bracket's budget is refused with [`SimError::OutOfRange`] naming `setpoint`.
 
 use super::{steady_tap_from, PeakForceOptions, SteadyTap};
 use crate::error::SimError;
@@ -194,6 +195,7 @@ impl Search<'_> {
         let (mut lo, mut g_lo, tap_lo) = lo;
         let (mut hi, mut g_hi, tap_hi) = hi;
         let mut side = 0i8;
+        let mut bisect = false;
         let mut best = if g_lo.abs() < g_hi.abs() {
             (lo, g_lo, tap_lo)
         } else {
@@ -204,17 +206,25 @@ impl Search<'_> {
                 break;
             }
             let x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-            let x = if x > lo && x < hi { x } else { 0.5 * (lo + hi) };
+            let x = if x > lo && x < hi && !bisect {
+                x
+            } else {
+                0.5 * (lo + hi)
+            };
             let (g, tap) = match self.eval(x) {
                 Ok(v) => v,
-                // a tap that does not settle grazes the sample: on the far (low-force) side
+                // a tap that does not settle grazes the sample: on the far (low-force) side;
+                // the ends' values are unchanged, so the next point bisects (a false position
+                // from them would fall beside this one)
                 Err(SimError::NoConvergence { .. }) => {
                     hi = x;
+                    bisect = true;
                     self.start.copy_from(&best.2.state);
                     continue;
                 }
                 Err(e) => return Err(e),
             };
+            bisect = false;
             if g.abs() < best.1.abs() {
                 best = (x, g, tap);
             }
