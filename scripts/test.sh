@@ -19,6 +19,8 @@
 #      its npm packages, served on 127.0.0.1, driven in Debian's headless Chromium, installed with
 #      apt-get when missing, by playwright-core, against the command line), and the book's pages
 #      opened in the same browser (explorer/tests/book.mjs).
+#   3 and 4 run in the background too, beside pytest, after the toy law; their output is printed
+#   after pytest's.
 # Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
 # The last line is "N passed, N failed", Rust, Python, the book, wasm and the explorer together;
 # the exit status is 0 only when everything ran and passed.
@@ -60,7 +62,8 @@ toy="$logs/toy"
 # (feature toy-law, not shipped: a law is one file plus one registry line) — its Rust test
 # (--workspace: the dependencies' features as the wheel's, which then reuses the library) and
 # its wheel, installed beside the venv's packages, not into them — then the browser suites'
-# tools and builds (scripts/prepare-browser.sh). Its output is printed after pytest.
+# tools and builds (scripts/prepare-browser.sh) and the browser suites. Its output is printed
+# after pytest.
 background() {
     echo "== Rust: cargo test --release --workspace --features afmdyn/toy-law --test toy_law"
     cargo test --release --workspace --features afmdyn/toy-law --test toy_law > "$logs/toy-rust.log" 2>&1
@@ -74,6 +77,15 @@ background() {
     fi
     echo "== the browser suites' tools and builds: bash scripts/prepare-browser.sh"
     bash scripts/prepare-browser.sh
+    # then the browser suites themselves, still beside pytest (their logs are printed after it)
+    run_suite wasm scripts/test-wasm.sh
+    run_suite explorer scripts/test-explorer.sh
+}
+# a suite whose script prints "NAME: N passed, M failed" last: its output and exit status into
+# $logs (count_suite reads them)
+run_suite() {
+    bash "$2" > "$logs/$1.log" 2>&1
+    echo $? > "$logs/$1.code"
 }
 if [ -x "$py" ]; then
     "$py" -m pip install -q --upgrade pip 2>&1 | tail -1
@@ -157,13 +169,14 @@ fi
 wait "$bindgen_job"
 cat "$logs/bindgen.log"
 
-# a suite whose script prints "NAME: N passed, M failed" last: its counts into NAME_passed and
-# NAME_failed; a non-zero exit without a counted failure counts as one
-suite() {
-    local name=$1 script=$2 code line
-    bash "$script" 2>&1 | tee "$logs/$name.log"
-    code=${PIPESTATUS[0]}
-    line=$(grep -E "^$name: [0-9]+ passed, [0-9]+ failed" "$logs/$name.log" | tail -1)
+# a browser suite's output, and its counts into NAME_passed and NAME_failed; a non-zero exit
+# (or none recorded) without a counted failure counts as one
+count_suite() {
+    local name=$1 title=$2 code line
+    echo "== $title"
+    cat "$logs/$name.log" 2>/dev/null
+    code=$(cat "$logs/$name.code" 2>/dev/null || echo 1)
+    line=$(grep -E "^$name: [0-9]+ passed, [0-9]+ failed" "$logs/$name.log" 2>/dev/null | tail -1)
     printf -v "${name}_passed" '%s' "$(echo "$line" | awk '{print $2 + 0}')"
     printf -v "${name}_failed" '%s' "$(echo "$line" | awk '{print $4 + 0}')"
     if [ "$code" -ne 0 ]; then
@@ -172,12 +185,8 @@ suite() {
         [ "${!f:-0}" -gt 0 ] || extra_failed=$((extra_failed + 1))
     fi
 }
-
-echo "== WebAssembly: bash scripts/test-wasm.sh (the browser engine under Node.js)"
-suite wasm scripts/test-wasm.sh
-
-echo "== Explorer: bash scripts/test-explorer.sh (the page in headless Chromium)"
-suite explorer scripts/test-explorer.sh
+count_suite wasm "WebAssembly: bash scripts/test-wasm.sh (the browser engine under Node.js)"
+count_suite explorer "Explorer: bash scripts/test-explorer.sh (the page in headless Chromium)"
 
 echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; book: ${book_passed} passed, ${book_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed; explorer: ${explorer_passed:-0} passed, ${explorer_failed:-0} failed"
 echo "$((rust_passed + py_passed + book_passed + ${wasm_passed:-0} + ${explorer_passed:-0})) passed, $((rust_failed + py_failed + book_failed + ${wasm_failed:-0} + ${explorer_failed:-0} + extra_failed)) failed"
