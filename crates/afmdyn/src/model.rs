@@ -719,15 +719,25 @@ impl CantileverModel {
         let k = self.m_eff;
         let mut out = z.clone();
         let mut jac = DMatrix::identity(2 * n, 2 * n);
+        let p = self.tip_projector();
         out.rows_mut(0, n).axpy(-k * v, &self.mphi, 1.0);
-        jac.view_mut((0, 0), (n, n))
-            .ger(-k, &self.mphi, self.tip(), 1.0);
+        jac.view_mut((0, 0), (n, n)).copy_from(&p);
         if vd < 0.0 {
             out.rows_mut(n, n).axpy(-k * vd, &self.mphi, 1.0);
-            jac.view_mut((n, n), (n, n))
-                .ger(-k, &self.mphi, self.tip(), 1.0);
+            jac.view_mut((n, n), (n, n)).copy_from(&p);
         }
         Some((out, jac))
+    }
+
+    /// P = I − m_eff M⁻¹φ φᵀ, shape `[N, N]`: the least change of the modal coordinates (in the
+    /// kinetic metric) that takes out their tip part, φᵀP = 0. The impact law's start on the
+    /// surface ([`CantileverModel::start_projection`]) and the thermal force while the tip
+    /// sticks (`crate::integrate::exact::noise`) use it.
+    pub(crate) fn tip_projector(&self) -> DMatrix<f64> {
+        let n = self.modes();
+        let mut p = DMatrix::identity(n, n);
+        p.ger(-self.m_eff, &self.mphi, self.tip(), 1.0);
+        p
     }
 
     /// The state at rest (a = ȧ = 0).

@@ -434,14 +434,7 @@ pub(crate) fn state_diffusion(
         d[(n, n)] = 2.0 * kt / model.params().alpha6;
     }
     if sticking(model, r) {
-        let m = model.modes();
-        let mut p = DMatrix::identity(m, m);
-        p.ger(
-            -model.effective_mass(),
-            model.tip_mobility(),
-            model.tip(),
-            1.0,
-        );
+        let (m, p) = (model.modes(), model.tip_projector());
         let vv = &p * d.view((m, m), (m, m)) * p.transpose();
         d.view_mut((m, m), (m, m))
             .copy_from(&(0.5 * (&vv + vv.transpose())));
